@@ -1,0 +1,3 @@
+#include <stdio.h>
+#include "zonetrace/zonetrace.h"
+int main(void) { printf("zonetrace %s\n", zt_version()); return 0; }

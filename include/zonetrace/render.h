@@ -1,0 +1,83 @@
+/* zonetrace: rendering.
+ *
+ * Two renderers share one scene, material, light and camera model
+ * (docs/light-transport.md): "path", an unbiased Monte Carlo path tracer,
+ * and "zone", the deterministic zone tracer.  Both understand levels: level
+ * L is the light that scattered exactly L times between a light and the
+ * eye (0 = lights seen directly, 1 = direct illumination, ...), and depth D
+ * keeps levels 0..D.
+ */
+#ifndef ZONETRACE_RENDER_H
+#define ZONETRACE_RENDER_H
+
+#include <stdint.h>
+#include "zonetrace/error.h"
+#include "zonetrace/image.h"
+#include "zonetrace/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum zt_method { ZT_METHOD_PATH = 0, ZT_METHOD_ZONE = 1 } zt_method;
+
+typedef enum zt_strategy {
+    ZT_STRATEGY_PIXEL = 0, /* zone tracer: pixel by pixel */
+    ZT_STRATEGY_ZONE = 1   /* zone tracer: zone by zone */
+} zt_strategy;
+
+/* Called from the rendering threads, serialised, about a hundred times per
+ * render.  done/total count work units (rows of tiles, zones...).  Return
+ * non-zero to cancel the render (it then fails with ZT_ERR_CANCELLED). */
+typedef int (*zt_progress_fn)(void *user, const char *stage, double done,
+                              double total);
+
+#define ZT_MAX_LIGHTS_OFF 64
+
+typedef struct zt_render_options {
+    zt_method method;
+    int spp;            /* path: samples per pixel (>= 1) */
+    int depth;          /* maximum scattering events (>= 0) */
+    int level;          /* < 0: all levels up to depth; else only this one */
+    uint64_t seed;      /* path: sampler seed */
+    int threads;        /* 0: all cores */
+    /* Light objects (by index, as in the scene file) that are switched off. */
+    int lights_off[ZT_MAX_LIGHTS_OFF];
+    int lights_off_count;
+    /* Zone tracer */
+    zt_strategy strategy;
+    double cutoff;      /* prune zones whose power bound is below this */
+    int quality;        /* zone: discretisation level, higher is finer */
+    zt_progress_fn progress;
+    void *progress_user;
+} zt_render_options;
+
+/* Defaults: path method, 64 spp, depth 16, all levels, seed 0, all cores. */
+zt_render_options zt_render_options_default(void);
+
+typedef struct zt_render_stats {
+    double seconds;        /* wall time of the whole render */
+    uint64_t samples;      /* camera samples taken */
+    uint64_t rays;         /* rays traced (camera, extension and shadow) */
+    int threads;           /* threads used */
+    /* zone tracer */
+    double phase_one_seconds;
+    double phase_two_seconds;
+    uint64_t zones;
+    uint64_t zones_pruned;
+    uint64_t zones_per_level[32];
+    uint64_t memory_bytes;
+} zt_render_stats;
+
+/* Renders the scene through its camera into a new linear image (*out, the
+ * caller's).  stats may be NULL. */
+zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
+                    zt_image **out, zt_render_stats *stats, zt_error *err);
+
+/* The library's version string, e.g. "0.1.0". */
+const char *zt_version(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,2 @@
+#include "zonetrace/render.h"
+const char *zt_version(void) { return ZT_VERSION; }

@@ -1,0 +1,231 @@
+/* Scene model: construction, copies, queries and rigid motions. */
+#include "scene/scene.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/error.h"
+
+zt_scene *scene_create(void)
+{
+    return calloc(1, sizeof(zt_scene));
+}
+
+void zt_scene_release(zt_scene *scene)
+{
+    if (!scene)
+        return;
+    free(scene->objects);
+    free(scene->parts);
+    free(scene);
+}
+
+static int grow(void **data, int *capacity, int needed, size_t elem)
+{
+    if (needed <= *capacity)
+        return 1;
+    int cap = *capacity ? *capacity * 2 : 16;
+    while (cap < needed)
+        cap *= 2;
+    void *p = realloc(*data, (size_t)cap * elem);
+    if (!p)
+        return 0;
+    *data = p;
+    *capacity = cap;
+    return 1;
+}
+
+int scene_add_object(zt_scene *scene, const object *obj)
+{
+    if (!grow((void **)&scene->objects, &scene->object_capacity,
+              scene->object_count + 1, sizeof(object)))
+        return -1;
+    object *o = &scene->objects[scene->object_count];
+    *o = *obj;
+    o->index = obj->is_light ? scene->light_count++ : scene->thing_count++;
+    o->first_part = scene->part_count;
+    o->part_count = 0;
+    return scene->object_count++;
+}
+
+int scene_add_part(zt_scene *scene, const part *p)
+{
+    if (scene->object_count == 0)
+        return -1;
+    if (!grow((void **)&scene->parts, &scene->part_capacity,
+              scene->part_count + 1, sizeof(part)))
+        return -1;
+    part *q = &scene->parts[scene->part_count];
+    *q = *p;
+    q->object = scene->object_count - 1;
+    scene->objects[q->object].part_count++;
+    return scene->part_count++;
+}
+
+material material_default(void)
+{
+    material m;
+    memset(&m, 0, sizeof m);
+    m.weight[LOBE_DIFFUSE] = 1.0;
+    m.ior = 1.0;
+    return m;
+}
+
+zt_scene *zt_scene_clone(const zt_scene *scene)
+{
+    zt_scene *c = scene_create();
+    if (!c)
+        return NULL;
+    *c = *scene;
+    c->objects = NULL;
+    c->parts = NULL;
+    c->object_capacity = scene->object_count;
+    c->part_capacity = scene->part_count;
+    if (scene->object_count) {
+        c->objects = malloc((size_t)scene->object_count * sizeof(object));
+        if (c->objects)
+            memcpy(c->objects, scene->objects, (size_t)scene->object_count * sizeof(object));
+    }
+    if (scene->part_count) {
+        c->parts = malloc((size_t)scene->part_count * sizeof(part));
+        if (c->parts)
+            memcpy(c->parts, scene->parts, (size_t)scene->part_count * sizeof(part));
+    }
+    if ((scene->object_count && !c->objects) || (scene->part_count && !c->parts)) {
+        zt_scene_release(c);
+        return NULL;
+    }
+    return c;
+}
+
+void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
+{
+    memset(out, 0, sizeof *out);
+    out->lights = scene->light_count;
+    out->things = scene->thing_count;
+    out->has_sky = scene->has_sky;
+    for (int i = 0; i < scene->part_count; i++) {
+        const part *p = &scene->parts[i];
+        if (scene->objects[p->object].is_light)
+            out->light_parts++;
+        else
+            out->thing_parts++;
+        switch (p->shape) {
+        case SHAPE_SPHERE: out->spheres++; break;
+        case SHAPE_PLANE: out->planes++; break;
+        case SHAPE_TRIANGLE: out->triangles++; break;
+        case SHAPE_POINT: out->points++; break;
+        }
+    }
+}
+
+zt_camera zt_scene_get_camera(const zt_scene *scene)
+{
+    return scene->camera;
+}
+
+void zt_scene_set_camera(zt_scene *scene, const zt_camera *camera)
+{
+    scene->camera = *camera;
+    scene->has_camera = 1;
+}
+
+int zt_scene_object_count(const zt_scene *scene, zt_object_class cls)
+{
+    return cls == ZT_OBJECT_LIGHT ? scene->light_count : scene->thing_count;
+}
+
+object *scene_find_object(zt_scene *scene, zt_object_class cls, int index)
+{
+    int want_light = cls == ZT_OBJECT_LIGHT;
+    for (int i = 0; i < scene->object_count; i++) {
+        object *o = &scene->objects[i];
+        if (o->is_light == want_light && o->index == index)
+            return o;
+    }
+    return NULL;
+}
+
+static object *find_or_fail(zt_scene *scene, zt_object_class cls, int index,
+                            zt_error *err)
+{
+    object *o = scene_find_object(scene, cls, index);
+    if (!o)
+        zt_fail(err, ZT_ERR_ARGUMENT, "no %s with index %d (the scene has %d)",
+                cls == ZT_OBJECT_LIGHT ? "light" : "thing", index,
+                zt_scene_object_count(scene, cls));
+    return o;
+}
+
+zt_status zt_scene_translate_object(zt_scene *scene, zt_object_class cls,
+                                    int index, const double delta[3],
+                                    zt_error *err)
+{
+    object *o = find_or_fail(scene, cls, index, err);
+    if (!o)
+        return ZT_ERR_ARGUMENT;
+    vec3 d = v3_from(delta);
+    for (int i = 0; i < o->part_count; i++) {
+        part *p = &scene->parts[o->first_part + i];
+        for (int k = 0; k < 3; k++)
+            p->p[k] = v3_add(p->p[k], d);
+        if (p->shape == SHAPE_PLANE)
+            p->offset += v3_dot(p->normal, d);
+    }
+    return ZT_OK;
+}
+
+zt_status zt_scene_rotate_object(zt_scene *scene, zt_object_class cls,
+                                 int index, int axis, double angle,
+                                 zt_error *err)
+{
+    if (axis < 0 || axis > 2)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "rotation axis must be 0, 1 or 2");
+    object *o = find_or_fail(scene, cls, index, err);
+    if (!o)
+        return ZT_ERR_ARGUMENT;
+    for (int i = 0; i < o->part_count; i++) {
+        part *p = &scene->parts[o->first_part + i];
+        for (int k = 0; k < 3; k++)
+            p->p[k] = v3_rotate_axis(p->p[k], axis, angle);
+        /* A plane through the origin-centred rotation keeps its offset. */
+        if (p->shape == SHAPE_PLANE)
+            p->normal = v3_rotate_axis(p->normal, axis, angle);
+    }
+    return ZT_OK;
+}
+
+zt_status zt_scene_object_position(const zt_scene *scene, zt_object_class cls,
+                                   int index, double out[3], zt_error *err)
+{
+    object *o = find_or_fail((zt_scene *)scene, cls, index, err);
+    if (!o)
+        return ZT_ERR_ARGUMENT;
+    vec3 sum = v3(0, 0, 0);
+    for (int i = 0; i < o->part_count; i++) {
+        const part *p = &scene->parts[o->first_part + i];
+        vec3 c;
+        if (p->shape == SHAPE_TRIANGLE)
+            c = v3_scale(v3_add(v3_add(p->p[0], p->p[1]), p->p[2]), 1.0 / 3.0);
+        else if (p->shape == SHAPE_PLANE)
+            c = v3_scale(p->normal, p->offset);
+        else
+            c = p->p[0];
+        sum = v3_add(sum, c);
+    }
+    v3_store(o->part_count ? v3_scale(sum, 1.0 / o->part_count) : sum, out);
+    return ZT_OK;
+}
+
+zt_status zt_camera_set_resolution(zt_camera *camera, int width, int height,
+                                   zt_error *err)
+{
+    if (width < 1 || height < 1 || width > 32768 || height > 32768 ||
+        (long long)width * height > (1LL << 28))
+        return zt_fail(err, ZT_ERR_ARGUMENT,
+                       "resolution %dx%d is out of range (1..32768 per side, "
+                       "at most 268435456 pixels)", width, height);
+    camera->width = width;
+    camera->height = height;
+    return ZT_OK;
+}

@@ -1,0 +1,100 @@
+#define _POSIX_C_SOURCE 200809L
+#include "test_support.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+const char *test_shared_dir(void)
+{
+    struct stat st;
+    if (stat(ZT_SHARED_DIR "/scenes", &st) == 0 && S_ISDIR(st.st_mode))
+        return ZT_SHARED_DIR;
+    fprintf(stderr, "note: %s is absent; tests that need the original "
+                    "programs' files are skipped\n", ZT_SHARED_DIR);
+    return NULL;
+}
+
+static void remove_tmp_dir(void);
+static char tmp_dir[256];
+
+const char *test_tmp_dir(void)
+{
+    if (!tmp_dir[0]) {
+        const char *base = getenv("TMPDIR");
+        snprintf(tmp_dir, sizeof tmp_dir, "%s/zt_test_XXXXXX", base ? base : "/tmp");
+        if (!mkdtemp(tmp_dir)) {
+            perror("mkdtemp");
+            abort();
+        }
+        atexit(remove_tmp_dir);
+    }
+    return tmp_dir;
+}
+
+static void remove_tmp_dir(void)
+{
+    char cmd[400];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmp_dir);
+    if (system(cmd) != 0)
+        fprintf(stderr, "warning: could not remove %s\n", tmp_dir);
+}
+
+const char *test_tmp_path(const char *name)
+{
+    static char bufs[8][512];
+    static int next;
+    char *b = bufs[next++ % 8];
+    snprintf(b, 512, "%s/%s", test_tmp_dir(), name);
+    return b;
+}
+
+const char *test_write_file(const char *name, const char *text)
+{
+    const char *path = test_tmp_path(name);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(text, 1, strlen(text), f) != strlen(text)) {
+        perror(path);
+        abort();
+    }
+    fclose(f);
+    return path;
+}
+
+char *test_read_file(const char *path, size_t *length)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    size_t cap = 4096, n = 0;
+    char *buf = malloc(cap);
+    size_t got;
+    while ((got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
+        n += got;
+        if (cap - n < 2) {
+            cap *= 2;
+            buf = realloc(buf, cap);
+        }
+    }
+    fclose(f);
+    buf[n] = '\0';
+    if (length)
+        *length = n;
+    return buf;
+}
+
+int test_run_cli(const char *args, char **err_out)
+{
+    const char *errpath = test_tmp_path("cli_stderr.txt");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "'%s' %s 2>'%s' </dev/null", ZT_CLI_PATH, args, errpath);
+    int status = system(cmd);
+    if (err_out)
+        *err_out = test_read_file(errpath, NULL);
+    if (status == -1 || !WIFEXITED(status))
+        return -1;
+    return WEXITSTATUS(status);
+}

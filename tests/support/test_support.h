@@ -1,0 +1,33 @@
+/* Helpers shared by the tests: temporary files, the shared/ folder, running
+ * the command line program. */
+#ifndef ZT_TEST_SUPPORT_H
+#define ZT_TEST_SUPPORT_H
+
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+/* The ../shared folder beside the clone, or NULL (with a message on stderr
+ * saying the test is skipped) when it is absent. */
+const char *test_shared_dir(void);
+
+/* A fresh temporary directory for this test process (created once). */
+const char *test_tmp_dir(void);
+
+/* tmp_dir/name in a static rotating buffer. */
+const char *test_tmp_path(const char *name);
+
+/* Writes text to tmp_dir/name and returns that path. */
+const char *test_write_file(const char *name, const char *text);
+
+/* Runs the zonetrace program with the given arguments (a shell-quoted
+ * string), capturing stderr into *err_out (malloc'd, may be NULL) and
+ * returning the exit status (or -1 if it died from a signal). */
+int test_run_cli(const char *args, char **err_out);
+
+/* Reads a whole file (malloc'd, NUL-terminated) or NULL. */
+char *test_read_file(const char *path, size_t *length);
+
+#endif
