@@ -1,3 +1,70 @@
+/* zonetrace: command line entry point and sub-command dispatch. */
+#include <stdarg.h>
 #include <stdio.h>
-#include "zonetrace/zonetrace.h"
-int main(void) { printf("zonetrace %s\n", zt_version()); return 0; }
+#include <string.h>
+
+#include "cli.h"
+
+static void print_usage(FILE *f)
+{
+    fprintf(f,
+        "usage: zonetrace render SCENE [options]   render a scene to an image\n"
+        "       zonetrace SCENE [options]          the same\n"
+        "       zonetrace compare IMAGE REFERENCE  error figures of an image\n"
+        "       zonetrace view SCENE [options]     interactive window\n"
+        "       zonetrace --help | --version\n"
+        "\n"
+        "'zonetrace render --help' lists the render options.\n");
+}
+
+int cli_exit_code(zt_status status)
+{
+    switch (status) {
+    case ZT_OK: return EXIT_OK;
+    case ZT_ERR_ARGUMENT: return EXIT_USAGE;
+    case ZT_ERR_READ: return EXIT_UNREADABLE;
+    case ZT_ERR_PARSE: return EXIT_UNPARSEABLE;
+    case ZT_ERR_WRITE: return EXIT_UNWRITABLE;
+    default: return EXIT_FAILURE_OTHER;
+    }
+}
+
+void cli_error(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("zonetrace: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        print_usage(stderr);
+        return EXIT_USAGE;
+    }
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+        print_usage(stdout);
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "--version")) {
+        printf("zonetrace %s\n", zt_version());
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "render"))
+        return cli_render(argc - 1, argv + 1);
+    if (!strcmp(cmd, "compare"))
+        return cli_compare(argc - 1, argv + 1);
+    if (!strcmp(cmd, "view"))
+        return cli_view(argc - 1, argv + 1);
+    if (cmd[0] == '-') {
+        cli_error("unknown option '%s' (expected a command or a scene file)", cmd);
+        print_usage(stderr);
+        return EXIT_USAGE;
+    }
+    /* "zonetrace SCENE ..." is "zonetrace render SCENE ...". */
+    return cli_render(argc, argv);
+}

@@ -1,0 +1,246 @@
+/* zonetrace render: load a scene, render it, write the image. */
+#define _POSIX_C_SOURCE 200809L
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "parse.h"
+
+static void render_usage(FILE *f)
+{
+    fprintf(f,
+"usage: zonetrace render SCENE [options]\n"
+"\n"
+"Renders SCENE (a scene file in the Retra/Silence JSON format) to an image.\n"
+"\n"
+"Output:\n"
+"  -o, --output FILE     image to write (default image.png); the format follows\n"
+"                        the extension: .pfm .exr (linear HDR), .png .ppm (8-bit);\n"
+"                        '-' writes PPM to standard output\n"
+"      --size WxH        pixel grid (default: the scene's gridresolution); the\n"
+"                        screen rectangle stays the same\n"
+"      --exposure EV     8-bit outputs: scale by 2^EV (default: automatic, the\n"
+"                        99th percentile of luminance maps to 0.9)\n"
+"      --gamma G         8-bit outputs: x^(1/G) (default: the sRGB curve)\n"
+"\n"
+"Light transport:\n"
+"      --method M        path (Monte Carlo reference, default) or zone\n"
+"      --depth D         at most D scattering events (default 16 for path)\n"
+"      --level L         only light that scattered exactly L times\n"
+"                        (0 = lights seen directly, 1 = direct light, ...)\n"
+"      --lights-off LIST switch off lights by index, e.g. 0,2 (they stay as\n"
+"                        black surfaces)\n"
+"\n"
+"Path tracer:\n"
+"      --spp N           samples per pixel (default 64)\n"
+"      --seed S          sampler seed (default 0); same seed, same image\n"
+"\n"
+"Zone tracer:\n"
+"      --strategy S      pixel (default) or zone\n"
+"      --cutoff X        prune zones whose power bound is below X (default 0)\n"
+"      --quality Q       discretisation level, higher is finer (default 2)\n"
+"\n"
+"Running:\n"
+"      --threads T       threads (default: all cores)\n"
+"  -v, --verbose         progress with ETA on stderr, and details\n"
+"  -q, --quiet           no statistics line\n"
+"  -h, --help            this text\n"
+"\n"
+"Exit status: 0 done, 1 bad arguments, 2 unreadable input, 3 invalid input,\n"
+"4 unwritable output, 5 other failure.\n");
+}
+
+enum {
+    OPT_SIZE = 256, OPT_SPP, OPT_DEPTH, OPT_LEVEL, OPT_SEED, OPT_THREADS,
+    OPT_METHOD, OPT_GAMMA, OPT_EXPOSURE, OPT_STRATEGY, OPT_CUTOFF, OPT_QUALITY,
+    OPT_LIGHTS_OFF
+};
+
+static const struct option long_options[] = {
+    {"output", required_argument, 0, 'o'},
+    {"size", required_argument, 0, OPT_SIZE},
+    {"spp", required_argument, 0, OPT_SPP},
+    {"depth", required_argument, 0, OPT_DEPTH},
+    {"level", required_argument, 0, OPT_LEVEL},
+    {"seed", required_argument, 0, OPT_SEED},
+    {"threads", required_argument, 0, OPT_THREADS},
+    {"method", required_argument, 0, OPT_METHOD},
+    {"gamma", required_argument, 0, OPT_GAMMA},
+    {"exposure", required_argument, 0, OPT_EXPOSURE},
+    {"strategy", required_argument, 0, OPT_STRATEGY},
+    {"cutoff", required_argument, 0, OPT_CUTOFF},
+    {"quality", required_argument, 0, OPT_QUALITY},
+    {"lights-off", required_argument, 0, OPT_LIGHTS_OFF},
+    {"verbose", no_argument, 0, 'v'},
+    {"quiet", no_argument, 0, 'q'},
+    {"help", no_argument, 0, 'h'},
+    {0, 0, 0, 0}
+};
+
+/* Whether the image can be written there, checked before a long render:
+ * a known extension and a writable directory (writes go through a
+ * temporary file beside the target). */
+static int output_writable(const char *path)
+{
+    if (!strcmp(path, "-"))
+        return 1;
+    if (zt_image_format_from_path(path) == ZT_FORMAT_UNKNOWN) {
+        cli_error("cannot tell the image format of '%s': use .png, .ppm, .pfm or .exr", path);
+        return -1;
+    }
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        cli_error("cannot write '%s': it is a directory", path);
+        return 0;
+    }
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        strcpy(dir, ".");
+    else if (slash == path)
+        strcpy(dir, "/");
+    else
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    if (access(dir, W_OK | X_OK) != 0) {
+        cli_error("cannot write '%s': directory '%s' is missing or not writable", path, dir);
+        return 0;
+    }
+    return 1;
+}
+
+int cli_render(int argc, char **argv)
+{
+    zt_render_options opt = zt_render_options_default();
+    zt_tonemap tm = zt_tonemap_default();
+    const char *output = "image.png";
+    int width = 0, height = 0, verbose = 0, quiet = 0, depth_given = 0;
+    unsigned long long seed = 0;
+    int c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":o:vqh", long_options, NULL)) != -1) {
+        int ok = 1;
+        switch (c) {
+        case 'o': output = optarg; break;
+        case OPT_SIZE: ok = parse_size("--size", optarg, &width, &height); break;
+        case OPT_SPP: ok = parse_int("--spp", optarg, 1, 1 << 24, &opt.spp); break;
+        case OPT_DEPTH: ok = parse_int("--depth", optarg, 0, 1024, &opt.depth); depth_given = 1; break;
+        case OPT_LEVEL: ok = parse_int("--level", optarg, 0, 1024, &opt.level); break;
+        case OPT_SEED: ok = parse_u64("--seed", optarg, &seed); opt.seed = seed; break;
+        case OPT_THREADS: ok = parse_int("--threads", optarg, 1, 1024, &opt.threads); break;
+        case OPT_METHOD:
+            if (!strcmp(optarg, "path")) opt.method = ZT_METHOD_PATH;
+            else if (!strcmp(optarg, "zone")) opt.method = ZT_METHOD_ZONE;
+            else { cli_error("--method expects 'path' or 'zone', not '%s'", optarg); ok = 0; }
+            break;
+        case OPT_STRATEGY:
+            if (!strcmp(optarg, "pixel")) opt.strategy = ZT_STRATEGY_PIXEL;
+            else if (!strcmp(optarg, "zone")) opt.strategy = ZT_STRATEGY_ZONE;
+            else { cli_error("--strategy expects 'pixel' or 'zone', not '%s'", optarg); ok = 0; }
+            break;
+        case OPT_GAMMA: ok = parse_double("--gamma", optarg, 0.01, 100, &tm.gamma); break;
+        case OPT_EXPOSURE:
+            ok = parse_double("--exposure", optarg, -100, 100, &tm.exposure);
+            tm.auto_exposure = 0;
+            break;
+        case OPT_CUTOFF: ok = parse_double("--cutoff", optarg, 0, 1e30, &opt.cutoff); break;
+        case OPT_QUALITY: ok = parse_int("--quality", optarg, 0, 16, &opt.quality); break;
+        case OPT_LIGHTS_OFF:
+            ok = parse_int_list("--lights-off", optarg, opt.lights_off, ZT_MAX_LIGHTS_OFF,
+                                &opt.lights_off_count);
+            break;
+        case 'v': verbose = 1; break;
+        case 'q': quiet = 1; break;
+        case 'h': render_usage(stdout); return EXIT_OK;
+        case ':': cli_error("option '%s' needs a value", argv[optind - 1]); ok = 0; break;
+        default: cli_error("unknown option '%s'", argv[optind - 1]); ok = 0; break;
+        }
+        if (!ok) {
+            fprintf(stderr, "Try 'zonetrace render --help'.\n");
+            return EXIT_USAGE;
+        }
+    }
+    if (optind >= argc) {
+        cli_error("no scene file given");
+        fprintf(stderr, "Try 'zonetrace render --help'.\n");
+        return EXIT_USAGE;
+    }
+    if (argc - optind > 1) {
+        cli_error("one scene file at a time ('%s' and '%s' given)", argv[optind], argv[optind + 1]);
+        return EXIT_USAGE;
+    }
+    const char *scene_path = argv[optind];
+    if (opt.method == ZT_METHOD_ZONE && !depth_given)
+        opt.depth = 3;
+    if (opt.level > opt.depth) {
+        if (depth_given) {
+            cli_error("--level %d is deeper than --depth %d (levels count from 0)",
+                      opt.level, opt.depth);
+            return EXIT_USAGE;
+        }
+        opt.depth = opt.level;
+    }
+    int w = output_writable(output);
+    if (w <= 0)
+        return w < 0 ? EXIT_USAGE : EXIT_UNWRITABLE;
+
+    zt_error err;
+    zt_error_clear(&err);
+    zt_scene *scene = NULL;
+    zt_status st = zt_scene_load_file(scene_path, &scene, &err);
+    if (st != ZT_OK) {
+        fprintf(stderr, "zonetrace: %s\n", err.message);
+        return cli_exit_code(st);
+    }
+    if (width) {
+        zt_camera cam = zt_scene_get_camera(scene);
+        if (zt_camera_set_resolution(&cam, width, height, &err) != ZT_OK) {
+            cli_error("%s", err.message);
+            zt_scene_release(scene);
+            return EXIT_USAGE;
+        }
+        zt_scene_set_camera(scene, &cam);
+    }
+    cli_progress prog;
+    cli_progress_init(&prog, verbose);
+    opt.progress = cli_progress_callback;
+    opt.progress_user = &prog;
+    if (verbose) {
+        zt_scene_info info;
+        zt_scene_get_info(scene, &info);
+        zt_camera cam = zt_scene_get_camera(scene);
+        fprintf(stderr, "scene %s: %d lights (%d parts), %d things (%d parts), %dx%d\n",
+                scene_path, info.lights, info.light_parts, info.things, info.thing_parts,
+                cam.width, cam.height);
+        fprintf(stderr, "method %s, depth %d, level %s%d\n",
+                opt.method == ZT_METHOD_PATH ? "path" : "zone", opt.depth,
+                opt.level < 0 ? "all up to " : "", opt.level < 0 ? opt.depth : opt.level);
+    }
+    zt_image *img = NULL;
+    zt_render_stats stats;
+    st = zt_render(scene, &opt, &img, &stats, &err);
+    cli_progress_finish(&prog);
+    zt_scene_release(scene);
+    if (st != ZT_OK) {
+        cli_error("%s", err.message);
+        return cli_exit_code(st);
+    }
+    st = zt_image_write(img, output, &tm, &err);
+    zt_image_release(img);
+    if (st != ZT_OK) {
+        cli_error("%s", err.message);
+        return cli_exit_code(st);
+    }
+    if (!quiet) {
+        double rps = stats.seconds > 0 ? stats.rays / stats.seconds : 0;
+        fprintf(stderr, "rendered %s in %.3f s: %llu samples, %llu rays, %.2f Mrays/s, %d threads\n",
+                strcmp(output, "-") ? output : "(stdout)", stats.seconds,
+                (unsigned long long)stats.samples, (unsigned long long)stats.rays,
+                rps / 1e6, stats.threads);
+    }
+    return EXIT_OK;
+}

@@ -1,0 +1,38 @@
+/* Nearest-hit and visibility queries: the one small interface behind which
+ * the acceleration structures live.
+ *
+ * The scene format's "background" rule is part of the query: a ray's hit is
+ * its nearest foreground hit if it has any, otherwise its nearest background
+ * hit.  Infinite planes are tested directly (there are few of them); the
+ * other primitives go to the chosen backend.
+ */
+#ifndef ZT_GEOM_ACCEL_H
+#define ZT_GEOM_ACCEL_H
+
+#include "geom/hit.h"
+#include "render/render_scene.h"
+
+typedef enum accel_kind {
+    ACCEL_EMBREE = 0, /* Intel Embree 3 (default) */
+    ACCEL_BRUTE = 1   /* every primitive, every ray: the test oracle */
+} accel_kind;
+
+/* Builds the structure for rs (rs->accel).  ZT_ERR_MEMORY or
+ * ZT_ERR_UNSUPPORTED on failure. */
+zt_status accel_build(rscene *rs, accel_kind kind, zt_error *err);
+
+void accel_free(struct accel *a);
+
+/* The hit of the ray (origin o, unit direction d) beyond tmin = 0 under the
+ * background rule; h.part = -1 when nothing is hit. */
+hit accel_intersect(const rscene *rs, vec3f o, vec3f d);
+
+/* Whether the point at distance dist along (o, d) is hidden: by a
+ * foreground primitive before dist; when the target is a background
+ * primitive also by any foreground primitive beyond it or a background one
+ * before it.  This is the same rule as accel_intersect, so a ray towards a
+ * point is unblocked exactly when it would hit that point. */
+int accel_occluded(const rscene *rs, vec3f o, vec3f d, float dist,
+                   int target_is_background);
+
+#endif

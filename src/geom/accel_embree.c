@@ -1,0 +1,220 @@
+/* The Embree 3 backend.  Each layer (foreground, background) is one Embree
+ * scene with up to two geometries: the triangles and the spheres.  Embree
+ * has no per-primitive back-face culling, so culled primitives are rejected
+ * in a filter function, attached only to geometries that have any. */
+#include "geom/accel_internal.h"
+
+#include <embree3/rtcore.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/error.h"
+
+enum { GEOM_TRIANGLES, GEOM_SPHERES, GEOM_KINDS };
+
+typedef struct geom_map {
+    int *part_of_prim;   /* primitive index -> part index */
+    const rscene *rs;
+    int kind;
+} geom_map;
+
+typedef struct embree_accel {
+    accel base;
+    RTCDevice device;
+    RTCScene scene[2];
+    int empty[2];
+    geom_map map[2][GEOM_KINDS]; /* by layer and geometry id (= kind) */
+} embree_accel;
+
+/* Rejects hits on the back of culled primitives. */
+static void cull_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    const geom_map *m = args->geometryUserPtr;
+    unsigned n = args->N;
+    const float *ray = (const float *)args->ray;
+    const float *hitv = (const float *)args->hit;
+    for (unsigned i = 0; i < n; i++) {
+        if (args->valid[i] != -1)
+            continue;
+        unsigned prim = ((const unsigned *)hitv)[5 * n + i];
+        const rs_part *p = &m->rs->parts[m->part_of_prim[prim]];
+        if (!p->culled)
+            continue;
+        vec3f d = f3(ray[4 * n + i], ray[5 * n + i], ray[6 * n + i]);
+        vec3f facing;
+        if (m->kind == GEOM_TRIANGLES) {
+            facing = p->n;
+        } else {
+            vec3f o = f3(ray[0 * n + i], ray[1 * n + i], ray[2 * n + i]);
+            float t = ray[8 * n + i];
+            facing = f3_sub(f3_madd(o, d, t), p->p0);
+        }
+        if (f3_dot(facing, d) >= 0.0f)
+            args->valid[i] = 0;
+    }
+}
+
+static void embree_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
+{
+    const embree_accel *e = (const embree_accel *)a;
+    if (e->empty[layer])
+        return;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
+    rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = h->t;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(e->scene[layer], &ctx, &rh);
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+        h->t = rh.ray.tfar;
+        h->part = e->map[layer][rh.hit.geomID].part_of_prim[rh.hit.primID];
+    }
+}
+
+static int embree_any(const accel *a, int layer, vec3f o, vec3f d, float tmax)
+{
+    const embree_accel *e = (const embree_accel *)a;
+    if (e->empty[layer])
+        return 0;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRay r;
+    r.org_x = o.x; r.org_y = o.y; r.org_z = o.z;
+    r.dir_x = d.x; r.dir_y = d.y; r.dir_z = d.z;
+    r.tnear = 0.0f;
+    r.tfar = tmax;
+    r.time = 0.0f;
+    r.mask = 0xffffffffu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(e->scene[layer], &ctx, &r);
+    return r.tfar < 0.0f;
+}
+
+static void embree_destroy(accel *a)
+{
+    embree_accel *e = (embree_accel *)a;
+    for (int l = 0; l < 2; l++) {
+        if (e->scene[l])
+            rtcReleaseScene(e->scene[l]);
+        for (int k = 0; k < GEOM_KINDS; k++)
+            free(e->map[l][k].part_of_prim);
+    }
+    if (e->device)
+        rtcReleaseDevice(e->device);
+    free(e);
+}
+
+/* Adds the layer's primitives of one shape as one geometry. */
+static int add_geometry(embree_accel *e, const rscene *rs, int layer, int kind)
+{
+    int shape = kind == GEOM_TRIANGLES ? SHAPE_TRIANGLE : SHAPE_SPHERE;
+    int count = 0, any_culled = 0;
+    for (int i = 0; i < rs->part_count; i++)
+        if (rs->parts[i].shape == shape && rs->parts[i].background == layer) {
+            count++;
+            any_culled |= rs->parts[i].culled;
+        }
+    if (count == 0)
+        return 1;
+    int *map = malloc((size_t)count * sizeof(int));
+    if (!map)
+        return 0;
+    RTCGeometry g = rtcNewGeometry(e->device, kind == GEOM_TRIANGLES
+                                                  ? RTC_GEOMETRY_TYPE_TRIANGLE
+                                                  : RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    float *vb;
+    unsigned *ib = NULL;
+    if (kind == GEOM_TRIANGLES) {
+        vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                     3 * sizeof(float), (size_t)count * 3);
+        ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                     3 * sizeof(unsigned), (size_t)count);
+    } else {
+        vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                     4 * sizeof(float), (size_t)count);
+    }
+    if (!vb || (kind == GEOM_TRIANGLES && !ib)) {
+        rtcReleaseGeometry(g);
+        free(map);
+        return 0;
+    }
+    int k = 0;
+    for (int i = 0; i < rs->part_count; i++) {
+        const rs_part *p = &rs->parts[i];
+        if (p->shape != shape || p->background != layer)
+            continue;
+        map[k] = i;
+        if (kind == GEOM_TRIANGLES) {
+            vec3f v[3] = {p->p0, f3_add(p->p0, p->e1), f3_add(p->p0, p->e2)};
+            for (int j = 0; j < 3; j++) {
+                vb[(k * 3 + j) * 3 + 0] = v[j].x;
+                vb[(k * 3 + j) * 3 + 1] = v[j].y;
+                vb[(k * 3 + j) * 3 + 2] = v[j].z;
+                ib[k * 3 + j] = (unsigned)(k * 3 + j);
+            }
+        } else {
+            vb[k * 4 + 0] = p->p0.x;
+            vb[k * 4 + 1] = p->p0.y;
+            vb[k * 4 + 2] = p->p0.z;
+            vb[k * 4 + 3] = p->radius;
+        }
+        k++;
+    }
+    geom_map *gm = &e->map[layer][kind];
+    gm->rs = rs;
+    gm->kind = kind;
+    if (any_culled) {
+        rtcSetGeometryUserData(g, gm);
+        rtcSetGeometryIntersectFilterFunction(g, cull_filter);
+        rtcSetGeometryOccludedFilterFunction(g, cull_filter);
+    }
+    rtcCommitGeometry(g);
+    /* The geometry id is the kind, so hits index map[layer] directly. */
+    rtcAttachGeometryByID(e->scene[layer], g, (unsigned)kind);
+    rtcReleaseGeometry(g);
+    gm->part_of_prim = map;
+    e->empty[layer] = 0;
+    return 1;
+}
+
+zt_status accel_build_embree(rscene *rs, zt_error *err)
+{
+    embree_accel *e = calloc(1, sizeof *e);
+    if (!e)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    e->base.nearest = embree_nearest;
+    e->base.any = embree_any;
+    e->base.destroy = embree_destroy;
+    e->device = rtcNewDevice(NULL);
+    if (!e->device) {
+        free(e);
+        return zt_fail(err, ZT_ERR_UNSUPPORTED, "Embree could not start (%d)",
+                       (int)rtcGetDeviceError(NULL));
+    }
+    for (int l = 0; l < 2; l++) {
+        e->empty[l] = 1;
+        e->scene[l] = rtcNewScene(e->device);
+        rtcSetSceneBuildQuality(e->scene[l], RTC_BUILD_QUALITY_HIGH);
+        for (int k = 0; k < GEOM_KINDS; k++)
+            if (!add_geometry(e, rs, l, k)) {
+                embree_destroy(&e->base);
+                return zt_fail(err, ZT_ERR_MEMORY, "out of memory building Embree scene");
+            }
+        rtcCommitScene(e->scene[l]);
+    }
+    if (rtcGetDeviceError(e->device) != RTC_ERROR_NONE) {
+        embree_destroy(&e->base);
+        return zt_fail(err, ZT_ERR_UNSUPPORTED, "Embree failed to build the scene");
+    }
+    rs->accel = &e->base;
+    return ZT_OK;
+}

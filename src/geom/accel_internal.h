@@ -1,0 +1,19 @@
+/* What a backend provides: raw nearest/any-hit queries over the non-plane
+ * primitives of one layer (0 foreground, 1 background). */
+#ifndef ZT_GEOM_ACCEL_INTERNAL_H
+#define ZT_GEOM_ACCEL_INTERNAL_H
+
+#include "geom/accel.h"
+
+typedef struct accel {
+    /* Lowers h->t and sets h->part if a nearer hit in (0, h->t) exists. */
+    void (*nearest)(const struct accel *a, int layer, vec3f o, vec3f d, hit *h);
+    /* Whether any primitive is hit in (0, tmax). */
+    int (*any)(const struct accel *a, int layer, vec3f o, vec3f d, float tmax);
+    void (*destroy)(struct accel *a);
+} accel;
+
+zt_status accel_build_embree(rscene *rs, zt_error *err);
+zt_status accel_build_brute(rscene *rs, zt_error *err);
+
+#endif

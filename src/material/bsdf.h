@@ -1,0 +1,52 @@
+/* The four-part material: a weighted sum of a Lambertian diffuse lobe, a
+ * Schlick-Fresnel metal reflector, an ideal mirror and a smooth dielectric,
+ * all tinted by the material colour (docs/light-transport.md).  Only the
+ * diffuse lobe has a density; the others are Dirac deltas. */
+#ifndef ZT_MATERIAL_BSDF_H
+#define ZT_MATERIAL_BSDF_H
+
+#include "render/render_scene.h"
+
+#define ZT_PI 3.14159265358979f
+
+typedef struct bsdf_sample {
+    vec3f wi;       /* new direction, unit */
+    vec3f weight;   /* f * |cos| / pdf: the throughput factor */
+    float pdf;      /* density of the diffuse choice (0 for deltas) */
+    int delta;      /* chosen lobe is a delta (no MIS) */
+    int transmit;   /* crossed the surface (refraction) */
+} bsdf_sample;
+
+/* f * cos of the diffuse lobe for unit wi, and its sampling density
+ * (lobe choice included), where n faces the side the light arrives on. */
+static inline vec3f bsdf_eval_diffuse(const rs_object *m, vec3f n, vec3f wi,
+                                      float *pdf)
+{
+    float c = f3_dot(n, wi);
+    if (c <= 0.0f) {
+        *pdf = 0.0f;
+        return f3_splat(0.0f);
+    }
+    float w = m->weight[LOBE_DIFFUSE];
+    *pdf = w * c / ZT_PI;
+    return f3_scale(m->color, w * c / ZT_PI);
+}
+
+/* Schlick's Fresnel with R0 from the index, as the original programs
+ * meant "metallic" (indices below 1 give metal-like R0). */
+float bsdf_schlick(float cos_i, float ior);
+
+/* Unpolarised Fresnel reflectance of a smooth dielectric, going from index
+ * eta_i into eta_t; 1 under total internal reflection. */
+float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t);
+
+/* Samples the material at a point with facing normal n (on the side of
+ * wo, the direction towards the previous vertex).  u_lobe picks the lobe,
+ * u_split reflection or transmission of the dielectric, u2 the diffuse
+ * direction.  eta_i/eta_t are the indices on wo's side and on the far
+ * side.  Returns 0 when the sample carries no light. */
+int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
+                         float u_split, const float u2[2], float eta_i,
+                         float eta_t, bsdf_sample *out);
+
+#endif

@@ -1,0 +1,76 @@
+/* The path tracer's driver: tiles over threads, samples per pixel, box
+ * filter.  Each pixel's samples depend only on the pixel, the sample index
+ * and the seed, so the image is the same at any thread count. */
+#include <omp.h>
+#include <stdlib.h>
+
+#include "camera/camera.h"
+#include "geom/accel.h"
+#include "path/path_tracer.h"
+#include "render/render_internal.h"
+#include "util/error.h"
+#include "util/sampler.h"
+
+#define TILE 16
+
+zt_status render_path(const zt_scene *scene, const zt_render_options *o,
+                      zt_image *img, zt_render_stats *stats, zt_error *err)
+{
+    rscene rs;
+    zt_status st = rscene_build(&rs, scene, o->lights_off, o->lights_off_count,
+                                render_accel_kind(), err);
+    if (st != ZT_OK)
+        return st;
+    cam c;
+    cam_init(&c, &scene->camera);
+    path_params pp;
+    pp.min_level = o->level >= 0 ? o->level : 0;
+    pp.max_level = o->level >= 0 ? o->level : o->depth;
+    pp.seed = (uint32_t)(o->seed ^ (o->seed >> 32));
+
+    int tiles_x = (img->width + TILE - 1) / TILE;
+    int tiles_y = (img->height + TILE - 1) / TILE;
+    int tiles = tiles_x * tiles_y;
+    int threads = render_thread_count(o->threads);
+    progress prog;
+    progress_init(&prog, o, "path", (double)tiles);
+    uint64_t rays = 0;
+    const uint32_t spp = (uint32_t)o->spp;
+
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays)
+    for (int t = 0; t < tiles; t++) {
+        if (prog.cancelled)
+            continue;
+        int x0 = (t % tiles_x) * TILE, y0 = (t / tiles_x) * TILE;
+        int x1 = x0 + TILE < img->width ? x0 + TILE : img->width;
+        int y1 = y0 + TILE < img->height ? y0 + TILE : img->height;
+        uint64_t local_rays = 0;
+        for (int y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++) {
+                uint32_t key = sampler_hash3((uint32_t)x, (uint32_t)y, pp.seed);
+                double sum[3] = {0, 0, 0};
+                for (uint32_t s = 0; s < spp; s++) {
+                    float u[2];
+                    sampler_get2(key, s, 0, u);
+                    vec3f org, dir;
+                    cam_ray(&c, (float)x + u[0], (float)y + u[1], &org, &dir);
+                    vec3f l = path_trace_sample(&rs, &pp, org, dir, key, s, &local_rays);
+                    sum[0] += l.x;
+                    sum[1] += l.y;
+                    sum[2] += l.z;
+                }
+                float *px = zt_image_pixel(img, x, y);
+                for (int k = 0; k < 3; k++)
+                    px[k] = (float)(sum[k] / spp);
+            }
+        rays += local_rays;
+        progress_add(&prog, 1.0);
+    }
+    rscene_free(&rs);
+    stats->threads = threads;
+    stats->rays = rays;
+    stats->samples = (uint64_t)img->width * (uint64_t)img->height * spp;
+    if (prog.cancelled)
+        return zt_fail(err, ZT_ERR_CANCELLED, "render cancelled");
+    return ZT_OK;
+}

@@ -1,0 +1,152 @@
+/* The estimator, vertex by vertex:
+ *   L += beta * Le * w_bsdf                      (emitter reached by a ray)
+ *   L += beta * f * cos * Li / p_light * w_light (next-event estimation)
+ *   beta *= f * cos / p_bsdf                     (continue the path)
+ * with w the power-heuristic MIS weights, and levels counted as the number
+ * of scattering events before the light reaches the eye. */
+#include "path/path_tracer.h"
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "geom/shapes.h"
+#include "light/light_sample.h"
+#include "material/bsdf.h"
+#include "util/sampler.h"
+
+#define MEDIUM_STACK 8
+#define RR_START 3
+/* Sampler dimension pairs: 0 is the pixel position; each scattering vertex
+ * uses PAIRS_PER_VERTEX after it (light point, BSDF direction). */
+#define PAIRS_PER_VERTEX 2
+/* Deeper vertices carry little of the image and use the plain stream. */
+#define STRATIFIED_VERTICES 3
+
+static inline float power_heuristic(float a, float b)
+{
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+/* The refractive objects the path is inside, innermost last: deciding
+ * entering/leaving by object identity makes shells of two surfaces work. */
+typedef struct media {
+    int obj[MEDIUM_STACK];
+    int n;
+} media;
+
+static float medium_ior(const rscene *rs, const media *m, int depth_from_top)
+{
+    int i = m->n - 1 - depth_from_top;
+    return i >= 0 ? rs->objects[m->obj[i]].ior : 1.0f;
+}
+
+vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
+                        vec3f d, uint32_t key, uint32_t index, uint64_t *rays)
+{
+    vec3f radiance = f3_splat(0.0f), beta = f3_splat(1.0f);
+    int k = 0;                /* scattering events so far */
+    int prev_delta = 1;       /* the camera counts as a delta vertex */
+    float prev_pdf = 0.0f;
+    vec3f prev_x = o;
+    media med = {{0}, 0};
+    sampler_stream rng = sampler_stream_start(key, index);
+
+    for (;;) {
+        hit h = accel_intersect(rs, o, d);
+        (*rays)++;
+        int counted = k >= pp->min_level;
+        if (h.part < 0) {
+            if (counted)
+                radiance = f3_add(radiance, f3_mul(beta, rs->sky));
+            break;
+        }
+        const rs_part *p = &rs->parts[h.part];
+        vec3f x = f3_madd(o, d, h.t);
+        if (p->is_light) {
+            if (counted) {
+                vec3f le = light_emitted(rs, p, x, d);
+                float w = 1.0f;
+                if (!prev_delta && p->light >= 0)
+                    w = power_heuristic(prev_pdf, light_pdf(rs, h.part, prev_x, d, h.t));
+                radiance = f3_add(radiance, f3_scale(f3_mul(beta, le), w));
+            }
+            break; /* lights absorb what reaches them */
+        }
+        if (k >= pp->max_level)
+            break;
+        k++;
+
+        const rs_object *m = &rs->objects[p->object];
+        vec3f ng = shape_normal(p, x);
+        vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
+        vec3f wo = f3_neg(d);
+        uint32_t pair = 1 + (uint32_t)(k - 1) * PAIRS_PER_VERTEX;
+        float u_light[2], u_dir[2], u_1d[4];
+        if (k <= STRATIFIED_VERTICES) {
+            sampler_get2(key, index, pair, u_light);
+            sampler_get2(key, index, pair + 1, u_dir);
+        } else {
+            u_light[0] = sampler_next(&rng);
+            u_light[1] = sampler_next(&rng);
+            u_dir[0] = sampler_next(&rng);
+            u_dir[1] = sampler_next(&rng);
+        }
+        for (int j = 0; j < 4; j++)
+            u_1d[j] = sampler_next(&rng);
+        vec3f x_out = ray_offset(x, n);
+
+        /* Next-event estimation through the diffuse lobe. */
+        light_sample ls;
+        if (k >= pp->min_level && m->weight[LOBE_DIFFUSE] > 0.0f &&
+            light_sample_point(rs, x, u_1d[0], u_light, &ls)) {
+            float bsdf_pdf;
+            vec3f fcos = bsdf_eval_diffuse(m, n, ls.wi, &bsdf_pdf);
+            if (bsdf_pdf > 0.0f && !f3_is_black(ls.li)) {
+                (*rays)++;
+                const rs_part *lp = &rs->parts[ls.part];
+                if (!accel_occluded(rs, x_out, ls.wi, ls.dist * 0.9999f, lp->background)) {
+                    float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
+                    radiance = f3_add(radiance,
+                                      f3_scale(f3_mul(f3_mul(beta, fcos), ls.li), w / ls.pdf));
+                }
+            }
+        }
+
+        /* Continue along a sampled direction. */
+        int entering = med.n == 0 || med.obj[med.n - 1] != p->object;
+        float eta_i = medium_ior(rs, &med, 0);
+        float eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
+        bsdf_sample bs;
+        if (!bsdf_sample_material(m, n, wo, u_1d[1], u_1d[2], u_dir,
+                                  eta_i, eta_t, &bs))
+            break;
+        beta = f3_mul(beta, bs.weight);
+        if (f3_is_black(beta))
+            break;
+        if (bs.transmit) {
+            if (entering) {
+                if (med.n < MEDIUM_STACK)
+                    med.obj[med.n++] = p->object;
+            } else {
+                med.n--;
+            }
+            o = ray_offset(x, f3_neg(n));
+        } else {
+            o = x_out;
+        }
+        prev_delta = bs.delta;
+        prev_pdf = bs.pdf;
+        prev_x = x;
+        d = bs.wi;
+
+        if (k >= RR_START) {
+            float q = fminf(0.95f, f3_max(beta));
+            if (u_1d[3] >= q)
+                break;
+            beta = f3_scale(beta, 1.0f / q);
+        }
+    }
+    if (!isfinite(radiance.x) || !isfinite(radiance.y) || !isfinite(radiance.z))
+        return f3_splat(0.0f);
+    return radiance;
+}

@@ -1,0 +1,140 @@
+/* Compiling the scene model into the renderers' flat arrays. */
+#include "render/render_scene.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "geom/accel.h"
+#include "util/error.h"
+
+static vec3f to_f(vec3 v) { return f3((float)v.x, (float)v.y, (float)v.z); }
+
+static int light_is_off(int index, const int *off, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (off[i] == index)
+            return 1;
+    return 0;
+}
+
+/* Emitted power up to the radiance's colour, used to share next-event
+ * samples among lights.  Planes are unbounded and not sampled (0). */
+static double part_power(const rs_part *p, const rs_object *o)
+{
+    double lum = f3_luminance(o->emission);
+    switch (p->shape) {
+    case SHAPE_TRIANGLE: return lum * p->area * 3.14159265358979 * (p->culled ? 1 : 2);
+    case SHAPE_SPHERE: return lum * p->area * 3.14159265358979;
+    case SHAPE_POINT: return lum * 4 * 3.14159265358979;
+    default: return 0;
+    }
+}
+
+static void fill_part(rs_part *rp, const part *p, const object *o)
+{
+    memset(rp, 0, sizeof *rp);
+    rp->shape = (uint8_t)p->shape;
+    rp->is_light = (uint8_t)o->is_light;
+    rp->culled = (uint8_t)o->backculled;
+    rp->background = (uint8_t)o->background;
+    rp->object = p->object;
+    rp->light = -1;
+    rp->p0 = to_f(p->p[0]);
+    switch (p->shape) {
+    case SHAPE_TRIANGLE: {
+        vec3 e1 = v3_sub(p->p[1], p->p[0]), e2 = v3_sub(p->p[2], p->p[0]);
+        vec3 c = v3_cross(e1, e2);
+        rp->e1 = to_f(e1);
+        rp->e2 = to_f(e2);
+        rp->n = to_f(v3_normalize(c));
+        rp->area = (float)(0.5 * v3_length(c));
+        break;
+    }
+    case SHAPE_SPHERE:
+        rp->radius = (float)p->radius;
+        rp->area = (float)(4 * 3.14159265358979 * p->radius * p->radius);
+        break;
+    case SHAPE_PLANE:
+        rp->n = to_f(p->normal);
+        rp->offset = (float)p->offset;
+        break;
+    default:
+        break;
+    }
+}
+
+zt_status rscene_build(rscene *rs, const zt_scene *scene,
+                       const int *lights_off, int lights_off_count,
+                       int accel_choice, zt_error *err)
+{
+    memset(rs, 0, sizeof *rs);
+    rs->part_count = scene->part_count;
+    rs->object_count = scene->object_count;
+    rs->parts = calloc((size_t)(scene->part_count + 1), sizeof(rs_part));
+    rs->objects = calloc((size_t)(scene->object_count + 1), sizeof(rs_object));
+    rs->lights = calloc((size_t)(scene->part_count + 1), sizeof(rs_light));
+    for (int l = 0; l < 2; l++)
+        rs->plane_parts[l] = calloc((size_t)(scene->part_count + 1), sizeof(int));
+    if (!rs->parts || !rs->objects || !rs->lights || !rs->plane_parts[0] ||
+        !rs->plane_parts[1]) {
+        rscene_free(rs);
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    }
+    rs->sky = to_f(scene->sky);
+
+    for (int i = 0; i < scene->object_count; i++) {
+        const object *o = &scene->objects[i];
+        rs_object *ro = &rs->objects[i];
+        for (int k = 0; k < LOBE_COUNT; k++)
+            ro->weight[k] = (float)o->mat.weight[k];
+        ro->color = to_f(o->mat.color);
+        ro->ior = (float)o->mat.ior;
+        ro->is_light = (uint8_t)o->is_light;
+        ro->culled = (uint8_t)o->backculled;
+        ro->background = (uint8_t)o->background;
+        if (o->is_light && !light_is_off(o->index, lights_off, lights_off_count))
+            ro->emission = to_f(o->emission);
+    }
+
+    double total = 0;
+    for (int i = 0; i < scene->part_count; i++) {
+        const part *p = &scene->parts[i];
+        rs_part *rp = &rs->parts[i];
+        fill_part(rp, p, &scene->objects[p->object]);
+        if (rp->shape == SHAPE_PLANE)
+            rs->plane_parts[rp->background][rs->plane_count[rp->background]++] = i;
+        double power = rp->is_light ? part_power(rp, &rs->objects[rp->object]) : 0;
+        if (power > 0) {
+            rp->light = rs->light_count;
+            rs->lights[rs->light_count].part = i;
+            rs->lights[rs->light_count].select_pdf = (float)power;
+            rs->light_count++;
+            total += power;
+        }
+    }
+    double cdf = 0;
+    for (int i = 0; i < rs->light_count; i++) {
+        double pdf = rs->lights[i].select_pdf / total;
+        cdf += pdf;
+        rs->lights[i].select_pdf = (float)pdf;
+        rs->lights[i].select_cdf = i == rs->light_count - 1 ? 1.0f : (float)cdf;
+    }
+
+    zt_status st = accel_build(rs, (accel_kind)accel_choice, err);
+    if (st != ZT_OK) {
+        rscene_free(rs);
+        return st;
+    }
+    return ZT_OK;
+}
+
+void rscene_free(rscene *rs)
+{
+    accel_free(rs->accel);
+    free(rs->parts);
+    free(rs->objects);
+    free(rs->lights);
+    free(rs->plane_parts[0]);
+    free(rs->plane_parts[1]);
+    memset(rs, 0, sizeof *rs);
+}

@@ -1,0 +1,70 @@
+/* The scene as the renderers see it: flat arrays in single precision,
+ * built once per render from the scene model, plus the acceleration
+ * structure and the table of lights. */
+#ifndef ZT_RENDER_RENDER_SCENE_H
+#define ZT_RENDER_RENDER_SCENE_H
+
+#include <stdint.h>
+#include "scene/scene.h"
+#include "util/vec3f.h"
+
+struct accel;
+
+/* One primitive.  The index of a part here equals its index in the scene
+ * model, so hits can be traced back to the file. */
+typedef struct rs_part {
+    uint8_t shape;      /* part_shape */
+    uint8_t is_light;
+    uint8_t culled;     /* backculled: invisible from behind */
+    uint8_t background;
+    int object;         /* index into rscene.objects */
+    int light;          /* index into rscene.lights, or -1 */
+    vec3f p0;           /* triangle vertex 0, sphere centre, point */
+    vec3f e1, e2;       /* triangle edges p1-p0, p2-p0 */
+    vec3f n;            /* triangle/plane unit normal (front side) */
+    float radius;       /* sphere */
+    float offset;       /* plane: n.x = offset */
+    float area;         /* triangle/sphere surface area */
+} rs_part;
+
+typedef struct rs_object {
+    float weight[LOBE_COUNT];
+    vec3f color;
+    float ior;
+    vec3f emission;     /* zero for things and for lights switched off */
+    uint8_t is_light;
+    uint8_t culled;
+    uint8_t background;
+} rs_object;
+
+/* An emitting part that next-event estimation can sample. */
+typedef struct rs_light {
+    int part;
+    float select_pdf;   /* probability of choosing this light */
+    float select_cdf;   /* cumulative, for the choice */
+} rs_light;
+
+typedef struct rscene {
+    rs_part *parts;
+    int part_count;
+    rs_object *objects;
+    int object_count;
+    rs_light *lights;   /* parts sampled by next-event estimation */
+    int light_count;
+    int *plane_parts[2];      /* [0] foreground, [1] background plane parts */
+    int plane_count[2];
+    vec3f sky;
+    struct accel *accel;
+} rscene;
+
+/* Builds the render scene with acceleration structure accel_kind (an
+ * accel_kind from geom/accel.h).  lights_off lists light objects (by index
+ * among the lights) whose emission is set to zero; they stay in the scene as
+ * black surfaces, so the images of single lights add up to the whole. */
+zt_status rscene_build(rscene *rs, const zt_scene *scene,
+                       const int *lights_off, int lights_off_count,
+                       int accel_choice, zt_error *err);
+
+void rscene_free(rscene *rs);
+
+#endif

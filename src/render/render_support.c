@@ -1,0 +1,52 @@
+#define _POSIX_C_SOURCE 200809L
+#include "render/render_internal.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "geom/accel.h"
+
+double render_clock(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int render_thread_count(int requested)
+{
+    return requested > 0 ? requested : omp_get_num_procs();
+}
+
+int render_accel_kind(void)
+{
+    const char *e = getenv("ZT_ACCEL");
+    return (e && strcmp(e, "brute") == 0) ? ACCEL_BRUTE : ACCEL_EMBREE;
+}
+
+void progress_init(progress *p, const zt_render_options *o, const char *stage,
+                   double total)
+{
+    memset(p, 0, sizeof *p);
+    p->fn = o->progress;
+    p->user = o->progress_user;
+    p->stage = stage;
+    p->total = total;
+    p->last_percent = -1;
+}
+
+void progress_add(progress *p, double amount)
+{
+#pragma omp critical(zt_progress)
+    {
+        p->done += amount;
+        int percent = p->total > 0 ? (int)(100.0 * p->done / p->total) : 100;
+        if (p->fn && percent != p->last_percent) {
+            p->last_percent = percent;
+            if (p->fn(p->user, p->stage, p->done, p->total))
+                p->cancelled = 1;
+        }
+    }
+}

@@ -1,0 +1,62 @@
+/* Materials: the four lobe weights, the albedo and the refractive index. */
+#include "scene/scene_reader.h"
+
+#include <math.h>
+
+#include "scene/load_values.h"
+
+/* The weights are a probability distribution over the lobes. */
+#define WEIGHT_SUM_TOLERANCE 1e-6
+
+static const char *const lobe_names[LOBE_COUNT] = {
+    "diffuse", "metallic", "reflecting", "refractive"
+};
+
+static zt_status load_character(load_ctx *ctx, jref ref, double *weight)
+{
+    static const char *const keys[] = {
+        "diffuse", "metallic", "reflecting", "refractive", NULL
+    };
+    if (load_object(ctx, ref, "character") ||
+        load_known_keys(ctx, ref, "character", keys))
+        return ZT_ERR_PARSE;
+    double sum = 0;
+    for (int i = 0; i < LOBE_COUNT; i++) {
+        jref w = jref_member(ref.value, lobe_names[i]);
+        if (load_require(ctx, ref, lobe_names[i], "character") ||
+            load_number(ctx, w, &weight[i]))
+            return ZT_ERR_PARSE;
+        if (weight[i] < 0 || weight[i] > 1)
+            return load_fail(ctx, w, "weight out of range: %s %g is not in [0, 1]",
+                             lobe_names[i], weight[i]);
+        sum += weight[i];
+    }
+    if (fabs(sum - 1) > WEIGHT_SUM_TOLERANCE)
+        return load_fail(ctx, ref, "weights must sum to 1, not %g", sum);
+    return ZT_OK;
+}
+
+zt_status load_material(load_ctx *ctx, jref ref, material *out)
+{
+    static const char *const keys[] = {
+        "character", "color", "refractiveindex", NULL
+    };
+    material m = material_default();
+    if (load_object(ctx, ref, "material") ||
+        load_known_keys(ctx, ref, "material", keys) ||
+        load_require(ctx, ref, "character", "material") ||
+        load_require(ctx, ref, "color", "material") ||
+        load_character(ctx, jref_member(ref.value, "character"), m.weight) ||
+        load_albedo(ctx, jref_member(ref.value, "color"), &m.color))
+        return ZT_ERR_PARSE;
+    jref ior = jref_member(ref.value, "refractiveindex");
+    if (ior.value) {
+        if (load_number(ctx, ior, &m.ior))
+            return ZT_ERR_PARSE;
+        if (m.ior <= 0)
+            return load_fail(ctx, ior, "refractiveindex must be positive, not %g",
+                             m.ior);
+    }
+    *out = m;
+    return ZT_OK;
+}

@@ -1,0 +1,33 @@
+/* The parts of the scene reader, each turning one kind of JSON value into
+ * the scene model.  All report through load_fail and return ZT_OK,
+ * ZT_ERR_PARSE or ZT_ERR_MEMORY. */
+#ifndef ZT_SCENE_SCENE_READER_H
+#define ZT_SCENE_SCENE_READER_H
+
+#include "scene/load_context.h"
+
+/* {"character": {...}, "color": [...], "refractiveindex": n} */
+zt_status load_material(load_ctx *ctx, jref ref, material *out);
+
+/* The top-level "camera" object. */
+zt_status load_camera(load_ctx *ctx, jref ref, zt_camera *out);
+
+/* The kinds of primitive a scene item can name. */
+typedef enum shape_kind {
+    KIND_SPHERE, KIND_PLANE, KIND_TRIANGLE,
+    KIND_LIGHTPOINT, KIND_LIGHTSPHERE, KIND_LIGHTPLANE, KIND_LIGHTTRIANGLE,
+    KIND_NONE
+} shape_kind;
+
+/* The kind named by key, or KIND_NONE. */
+shape_kind shape_kind_of(const char *key);
+int shape_kind_is_light(shape_kind kind);
+
+/* Reads the geometry of a primitive body (ref, already known to be an
+ * object whose keys are all allowed) into *out. */
+zt_status load_shape(load_ctx *ctx, shape_kind kind, jref body, part *out);
+
+/* The top-level "scene" list: adds every object to ctx->scene. */
+zt_status load_scene_list(load_ctx *ctx, jref ref);
+
+#endif
