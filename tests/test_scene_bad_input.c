@@ -49,7 +49,7 @@ static const bad_case cases[] = {
                       "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[["
                       TAIL, 3, 0, "nesting too deep"},
     {"duplicate_key", ITEM("{\"sphere\": {\"center\": [0, 0, 0], \"radius\": 1, \"radius\": 2}}"), 3, 47, "duplicate"},
-    {"second_camera", HEAD "{\"lightpoint\": {\"point\": [0, 0, 0]}}" TAIL "{}", 7, 0, "end of file expected"},
+    {"object_after_top_level", HEAD "{\"lightpoint\": {\"point\": [0, 0, 0]}}" TAIL "{}", 7, 0, "end of file expected"},
     {"duplicate_camera", "{\n\"scene\": [],\n\"camera\": " CAMERA_VALUE ",\n\"camera\": " CAMERA_VALUE "\n}\n",
      4, 1, "duplicate"},
     /* types */

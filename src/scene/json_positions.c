@@ -197,16 +197,16 @@ size_t json_positions_root(const json_positions *pos)
 }
 
 /* The member slot of key in object, or SOURCE_OFFSET_UNKNOWN. */
-static size_t member_slot(const json_positions *pos, const json_t *object,
+static size_t member_slot(const json_positions *pos, const json_t *obj,
                           const char *key)
 {
-    size_t first = table_get(pos, object);
-    if (first == SOURCE_OFFSET_UNKNOWN || !json_is_object(object))
+    size_t first = table_get(pos, obj);
+    if (first == SOURCE_OFFSET_UNKNOWN || !json_is_object(obj))
         return SOURCE_OFFSET_UNKNOWN;
     size_t i = 0;
     const char *k;
     json_t *child;
-    json_object_foreach((json_t *)object, k, child) {
+    json_object_foreach((json_t *)obj, k, child) {
         if (strcmp(k, key) == 0)
             return first + i;
         i++;
@@ -214,17 +214,17 @@ static size_t member_slot(const json_positions *pos, const json_t *object,
     return SOURCE_OFFSET_UNKNOWN;
 }
 
-size_t json_positions_member(const json_positions *pos, const json_t *object,
+size_t json_positions_member(const json_positions *pos, const json_t *obj,
                              const char *key)
 {
-    size_t slot = pos ? member_slot(pos, object, key) : SOURCE_OFFSET_UNKNOWN;
+    size_t slot = pos ? member_slot(pos, obj, key) : SOURCE_OFFSET_UNKNOWN;
     return slot == SOURCE_OFFSET_UNKNOWN ? slot : pos->value_at[slot];
 }
 
-size_t json_positions_key(const json_positions *pos, const json_t *object,
+size_t json_positions_key(const json_positions *pos, const json_t *obj,
                           const char *key)
 {
-    size_t slot = pos ? member_slot(pos, object, key) : SOURCE_OFFSET_UNKNOWN;
+    size_t slot = pos ? member_slot(pos, obj, key) : SOURCE_OFFSET_UNKNOWN;
     return slot == SOURCE_OFFSET_UNKNOWN ? slot : pos->key_at[slot];
 }
 

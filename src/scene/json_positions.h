@@ -26,9 +26,9 @@ void json_positions_free(json_positions *pos);
 /* Offsets of the root value, of the value and of the key of an object's
  * member, and of an array's element; SOURCE_OFFSET_UNKNOWN if not known. */
 size_t json_positions_root(const json_positions *pos);
-size_t json_positions_member(const json_positions *pos, const json_t *object,
+size_t json_positions_member(const json_positions *pos, const json_t *obj,
                              const char *key);
-size_t json_positions_key(const json_positions *pos, const json_t *object,
+size_t json_positions_key(const json_positions *pos, const json_t *obj,
                           const char *key);
 size_t json_positions_element(const json_positions *pos, const json_t *array,
                               size_t index);

@@ -12,9 +12,9 @@ jref jref_root(const json_t *root)
     return r;
 }
 
-jref jref_member(const json_t *object, const char *key)
+jref jref_member(const json_t *obj, const char *key)
 {
-    jref r = {json_object_get(object, key), object, key, 0};
+    jref r = {json_object_get(obj, key), obj, key, 0};
     return r;
 }
 
@@ -69,13 +69,13 @@ zt_status load_fail(load_ctx *ctx, jref ref, const char *fmt, ...)
     return s;
 }
 
-zt_status load_fail_key(load_ctx *ctx, const json_t *object, const char *key,
+zt_status load_fail_key(load_ctx *ctx, const json_t *obj, const char *key,
                         const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
     zt_status s = vfail(ctx, ZT_ERR_PARSE,
-                        json_positions_key(ctx->positions, object, key), fmt, ap);
+                        json_positions_key(ctx->positions, obj, key), fmt, ap);
     va_end(ap);
     return s;
 }

@@ -27,7 +27,7 @@ typedef struct jref {
 } jref;
 
 jref jref_root(const json_t *root);
-jref jref_member(const json_t *object, const char *key);
+jref jref_member(const json_t *obj, const char *key);
 jref jref_element(const json_t *array, size_t index);
 
 /* Records a ZT_ERR_PARSE at the start of ref's value (or, for a missing
@@ -36,7 +36,7 @@ zt_status load_fail(load_ctx *ctx, jref ref, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
 /* The same at the key of a member (for unknown keys). */
-zt_status load_fail_key(load_ctx *ctx, const json_t *object, const char *key,
+zt_status load_fail_key(load_ctx *ctx, const json_t *obj, const char *key,
                         const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 

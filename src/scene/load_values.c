@@ -27,27 +27,27 @@ zt_status load_object(load_ctx *ctx, jref ref, const char *what)
     return ZT_OK;
 }
 
-zt_status load_known_keys(load_ctx *ctx, jref object, const char *what,
+zt_status load_known_keys(load_ctx *ctx, jref obj, const char *what,
                           const char *const *allowed)
 {
     const char *key;
     json_t *value;
-    json_object_foreach((json_t *)object.value, key, value) {
+    json_object_foreach((json_t *)obj.value, key, value) {
         int known = 0;
         for (const char *const *a = allowed; *a && !known; a++)
             known = strcmp(*a, key) == 0;
         if (!known)
-            return load_fail_key(ctx, object.value, key,
+            return load_fail_key(ctx, obj.value, key,
                                  "unknown key \"%s\" in %s", key, what);
     }
     return ZT_OK;
 }
 
-zt_status load_require(load_ctx *ctx, jref object, const char *key,
+zt_status load_require(load_ctx *ctx, jref obj, const char *key,
                        const char *what)
 {
-    if (!json_object_get(object.value, key))
-        return load_fail(ctx, object, "missing \"%s\" in %s", key, what);
+    if (!json_object_get(obj.value, key))
+        return load_fail(ctx, obj, "missing \"%s\" in %s", key, what);
     return ZT_OK;
 }
 

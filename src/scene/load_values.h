@@ -17,11 +17,11 @@ zt_status load_object(load_ctx *ctx, jref ref, const char *what);
 
 /* Fails at the first key of object (ref) that is not in the NULL-terminated
  * list `allowed`, naming the key and `what`. */
-zt_status load_known_keys(load_ctx *ctx, jref object, const char *what,
+zt_status load_known_keys(load_ctx *ctx, jref obj, const char *what,
                           const char *const *allowed);
 
 /* Fails at object (ref) when member key is missing. */
-zt_status load_require(load_ctx *ctx, jref object, const char *key,
+zt_status load_require(load_ctx *ctx, jref obj, const char *key,
                        const char *what);
 
 /* A finite number with |x| <= LOAD_NUMBER_LIMIT. */

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs what zonetrace needs to build, test and run, from Debian 12's
+# packages.  Safe to run again: it only calls apt-get for missing packages.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config   # compiler and build
+  libjansson-dev                     # JSON parsing of scene files
+  libembree-dev                      # ray traversal (Intel Embree 3)
+  libopenexr-dev                     # OpenEXR output (its C API, OpenEXRCore)
+  libpng-dev                         # PNG output
+  libsdl2-dev                        # the interactive viewer's window
+  libcmocka-dev                      # the test framework
+  xvfb xauth                         # an X server for the viewer's tests
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: everything is installed"
+  exit 0
+fi
+
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install-deps: run as root or install sudo" >&2; exit 1; }
+  sudo="sudo"
+fi
+echo "install-deps: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
