@@ -5,26 +5,54 @@
 
 #include "geom/shapes.h"
 
+/* Planes: t = (offset - n.o) / (n.d), valid in (0, tmax) and, for culled
+ * planes, only from the front.  The distances are computed for all planes
+ * first (independent divisions, which pipeline and vectorise) and reduced
+ * after; a failed division (n.d = 0) gives inf or nan, which compare false. */
+#define PLANE_BATCH 16
+
+static int plane_distances(const rs_plane *pl, int n, vec3f o, vec3f d,
+                           float *t)
+{
+    for (int i = 0; i < n; i++) {
+        float dn = d.x * pl[i].n.x + d.y * pl[i].n.y + d.z * pl[i].n.z;
+        float num = pl[i].offset - (o.x * pl[i].n.x + o.y * pl[i].n.y + o.z * pl[i].n.z);
+        float ti = num / dn;
+        t[i] = (pl[i].culled && dn >= 0.0f) ? -1.0f : ti;
+    }
+    return n;
+}
+
 static void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d,
                            hit *h)
 {
-    for (int i = 0; i < rs->plane_count[layer]; i++) {
-        int pi = rs->plane_parts[layer][i];
-        float t = shape_plane_hit(&rs->parts[pi], o, d, 0.0f, h->t);
-        if (t > 0.0f) {
-            h->t = t;
-            h->part = pi;
-        }
+    const rs_plane *pl = rs->planes[layer];
+    float t[PLANE_BATCH];
+    for (int start = 0; start < rs->plane_count[layer]; start += PLANE_BATCH) {
+        int n = rs->plane_count[layer] - start;
+        n = plane_distances(pl + start, n < PLANE_BATCH ? n : PLANE_BATCH, o, d, t);
+        for (int i = 0; i < n; i++)
+            if (t[i] > 0.0f && t[i] < h->t) {
+                h->t = t[i];
+                h->part = pl[start + i].part;
+            }
     }
 }
 
 static int planes_any(const rscene *rs, int layer, vec3f o, vec3f d,
                       float tmax)
 {
-    for (int i = 0; i < rs->plane_count[layer]; i++)
-        if (shape_plane_hit(&rs->parts[rs->plane_parts[layer][i]], o, d, 0.0f,
-                            tmax) > 0.0f)
+    const rs_plane *pl = rs->planes[layer];
+    float t[PLANE_BATCH];
+    for (int start = 0; start < rs->plane_count[layer]; start += PLANE_BATCH) {
+        int n = rs->plane_count[layer] - start;
+        n = plane_distances(pl + start, n < PLANE_BATCH ? n : PLANE_BATCH, o, d, t);
+        int any = 0;
+        for (int i = 0; i < n; i++)
+            any |= t[i] > 0.0f && t[i] < tmax;
+        if (any)
             return 1;
+    }
     return 0;
 }
 
@@ -61,11 +89,14 @@ void accel_free(struct accel *a)
         a->destroy(a);
 }
 
+zt_status accel_build_bvh(rscene *rs, zt_error *err); /* accel_bvh.c */
+
 zt_status accel_build(rscene *rs, accel_kind kind, zt_error *err)
 {
     switch (kind) {
     case ACCEL_EMBREE: return accel_build_embree(rs, err);
     case ACCEL_BRUTE: return accel_build_brute(rs, err);
+    case ACCEL_BVH: return accel_build_bvh(rs, err);
     }
     return ZT_ERR_ARGUMENT;
 }

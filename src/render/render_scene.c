@@ -74,9 +74,8 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
     rs->objects = calloc((size_t)(scene->object_count + 1), sizeof(rs_object));
     rs->lights = calloc((size_t)(scene->part_count + 1), sizeof(rs_light));
     for (int l = 0; l < 2; l++)
-        rs->plane_parts[l] = calloc((size_t)(scene->part_count + 1), sizeof(int));
-    if (!rs->parts || !rs->objects || !rs->lights || !rs->plane_parts[0] ||
-        !rs->plane_parts[1]) {
+        rs->planes[l] = calloc((size_t)(scene->part_count + 1), sizeof(rs_plane));
+    if (!rs->parts || !rs->objects || !rs->lights || !rs->planes[0] || !rs->planes[1]) {
         rscene_free(rs);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     }
@@ -101,8 +100,13 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
         const part *p = &scene->parts[i];
         rs_part *rp = &rs->parts[i];
         fill_part(rp, p, &scene->objects[p->object]);
-        if (rp->shape == SHAPE_PLANE)
-            rs->plane_parts[rp->background][rs->plane_count[rp->background]++] = i;
+        if (rp->shape == SHAPE_PLANE) {
+            rs_plane *pl = &rs->planes[rp->background][rs->plane_count[rp->background]++];
+            pl->n = rp->n;
+            pl->offset = rp->offset;
+            pl->part = i;
+            pl->culled = rp->culled;
+        }
         double power = rp->is_light ? part_power(rp, &rs->objects[rp->object]) : 0;
         if (power > 0) {
             rp->light = rs->light_count;
@@ -134,7 +138,7 @@ void rscene_free(rscene *rs)
     free(rs->parts);
     free(rs->objects);
     free(rs->lights);
-    free(rs->plane_parts[0]);
-    free(rs->plane_parts[1]);
+    free(rs->planes[0]);
+    free(rs->planes[1]);
     memset(rs, 0, sizeof *rs);
 }

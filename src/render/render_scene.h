@@ -44,6 +44,13 @@ typedef struct rs_light {
     float select_cdf;   /* cumulative, for the choice */
 } rs_light;
 
+typedef struct rs_plane {
+    vec3f n;
+    float offset;
+    int part;
+    int culled;
+} rs_plane;
+
 typedef struct rscene {
     rs_part *parts;
     int part_count;
@@ -51,7 +58,10 @@ typedef struct rscene {
     int object_count;
     rs_light *lights;   /* parts sampled by next-event estimation */
     int light_count;
-    int *plane_parts[2];      /* [0] foreground, [1] background plane parts */
+    /* Infinite planes of each layer ([0] foreground, [1] background), kept
+     * apart from the other primitives as compact arrays: they are tested
+     * against every ray. */
+    rs_plane *planes[2];
     int plane_count[2];
     vec3f sky;
     struct accel *accel;

@@ -23,7 +23,11 @@ int render_thread_count(int requested)
 int render_accel_kind(void)
 {
     const char *e = getenv("ZT_ACCEL");
-    return (e && strcmp(e, "brute") == 0) ? ACCEL_BRUTE : ACCEL_EMBREE;
+    if (e && strcmp(e, "brute") == 0)
+        return ACCEL_BRUTE;
+    if (e && strcmp(e, "bvh") == 0)
+        return ACCEL_BVH;
+    return ACCEL_EMBREE;
 }
 
 void progress_init(progress *p, const zt_render_options *o, const char *stage,
