@@ -74,6 +74,32 @@ typedef struct zt_render_stats {
 zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
                     zt_image **out, zt_render_stats *stats, zt_error *err);
 
+/* A renderer kept between images: the scene's acceleration structure (and,
+ * for the zone tracer, its forest) is built once, so a moving camera or more
+ * samples cost only the rendering itself.  Used by the viewer. */
+typedef struct zt_renderer zt_renderer;
+
+/* Prepares scene (copied: later changes to it do not affect the renderer)
+ * for rendering with options.  *out is the caller's. */
+zt_status zt_renderer_create(const zt_scene *scene,
+                             const zt_render_options *options,
+                             zt_renderer **out, zt_error *err);
+
+/* Replaces the camera (its resolution may change too). */
+zt_status zt_renderer_set_camera(zt_renderer *renderer, const zt_camera *camera,
+                                 zt_error *err);
+
+/* Adds samples first_sample .. first_sample+count-1 of every pixel (path
+ * tracer; the zone tracer ignores the numbers and renders its one image)
+ * to sum, an image of the camera's size holding running sums of radiance.
+ * Samples are numbered, so sums of consecutive batches equal one render
+ * with the total count: sum/count is the image.  stats may be NULL. */
+zt_status zt_renderer_accumulate(zt_renderer *renderer, int first_sample,
+                                 int count, zt_image *sum,
+                                 zt_render_stats *stats, zt_error *err);
+
+void zt_renderer_release(zt_renderer *renderer);
+
 /* The library's version string, e.g. "0.1.0". */
 const char *zt_version(void);
 

@@ -13,63 +13,59 @@
 
 #define TILE 16
 
-zt_status render_path(const zt_scene *scene, const zt_render_options *o,
-                      zt_image *img, zt_render_stats *stats, zt_error *err)
+zt_status path_accumulate(zt_renderer *r, int first, int count, zt_image *sum,
+                          zt_render_stats *stats, zt_error *err)
 {
-    rscene rs;
-    zt_status st = rscene_build(&rs, scene, o->lights_off, o->lights_off_count,
-                                render_accel_kind(), err);
-    if (st != ZT_OK)
-        return st;
+    const zt_render_options *o = &r->options;
+    const rscene *rs = &r->rs;
     cam c;
-    cam_init(&c, &scene->camera);
+    cam_init(&c, &r->scene->camera);
     path_params pp;
     pp.min_level = o->level >= 0 ? o->level : 0;
     pp.max_level = o->level >= 0 ? o->level : o->depth;
     pp.seed = (uint32_t)(o->seed ^ (o->seed >> 32));
 
-    int tiles_x = (img->width + TILE - 1) / TILE;
-    int tiles_y = (img->height + TILE - 1) / TILE;
+    int tiles_x = (sum->width + TILE - 1) / TILE;
+    int tiles_y = (sum->height + TILE - 1) / TILE;
     int tiles = tiles_x * tiles_y;
     int threads = render_thread_count(o->threads);
     progress prog;
     progress_init(&prog, o, "path", (double)tiles);
     uint64_t rays = 0;
-    const uint32_t spp = (uint32_t)o->spp;
+    const uint32_t s0 = (uint32_t)first, s1 = (uint32_t)first + (uint32_t)count;
 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays)
     for (int t = 0; t < tiles; t++) {
         if (prog.cancelled)
             continue;
         int x0 = (t % tiles_x) * TILE, y0 = (t / tiles_x) * TILE;
-        int x1 = x0 + TILE < img->width ? x0 + TILE : img->width;
-        int y1 = y0 + TILE < img->height ? y0 + TILE : img->height;
+        int x1 = x0 + TILE < sum->width ? x0 + TILE : sum->width;
+        int y1 = y0 + TILE < sum->height ? y0 + TILE : sum->height;
         uint64_t local_rays = 0;
         for (int y = y0; y < y1; y++)
             for (int x = x0; x < x1; x++) {
                 uint32_t key = sampler_hash3((uint32_t)x, (uint32_t)y, pp.seed);
-                double sum[3] = {0, 0, 0};
-                for (uint32_t s = 0; s < spp; s++) {
+                double acc[3] = {0, 0, 0};
+                for (uint32_t s = s0; s < s1; s++) {
                     float u[2];
                     sampler_get2(key, s, 0, u);
                     vec3f org, dir;
                     cam_ray(&c, (float)x + u[0], (float)y + u[1], &org, &dir);
-                    vec3f l = path_trace_sample(&rs, &pp, org, dir, key, s, &local_rays);
-                    sum[0] += l.x;
-                    sum[1] += l.y;
-                    sum[2] += l.z;
+                    vec3f l = path_trace_sample(rs, &pp, org, dir, key, s, &local_rays);
+                    acc[0] += l.x;
+                    acc[1] += l.y;
+                    acc[2] += l.z;
                 }
-                float *px = zt_image_pixel(img, x, y);
+                float *px = zt_image_pixel(sum, x, y);
                 for (int k = 0; k < 3; k++)
-                    px[k] = (float)(sum[k] / spp);
+                    px[k] += (float)acc[k];
             }
         rays += local_rays;
         progress_add(&prog, 1.0);
     }
-    rscene_free(&rs);
     stats->threads = threads;
     stats->rays = rays;
-    stats->samples = (uint64_t)img->width * (uint64_t)img->height * spp;
+    stats->samples = (uint64_t)sum->width * (uint64_t)sum->height * (uint64_t)count;
     if (prog.cancelled)
         return zt_fail(err, ZT_ERR_CANCELLED, "render cancelled");
     return ZT_OK;

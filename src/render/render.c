@@ -1,7 +1,8 @@
-/* zt_render: option checks, the render scene, and the dispatch to a
- * renderer. */
+/* zt_render and the persistent renderer: option checks, the render scene,
+ * and the dispatch to the path or zone tracer. */
 #include "zonetrace/render.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 #include "geom/accel.h"
@@ -20,11 +21,21 @@ zt_render_options zt_render_options_default(void)
     return o;
 }
 
+static zt_status check_camera(const zt_camera *c, zt_error *err)
+{
+    if (c->width < 1 || c->height < 1)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "the camera has no pixels (%dx%d)",
+                       c->width, c->height);
+    return ZT_OK;
+}
+
 static zt_status check_options(const zt_scene *scene, const zt_render_options *o,
                                zt_error *err)
 {
     if (o->method != ZT_METHOD_PATH && o->method != ZT_METHOD_ZONE)
         return zt_fail(err, ZT_ERR_ARGUMENT, "unknown method %d", (int)o->method);
+    if (o->strategy != ZT_STRATEGY_PIXEL && o->strategy != ZT_STRATEGY_ZONE)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "unknown strategy %d", (int)o->strategy);
     if (o->spp < 1 || o->spp > (1 << 24))
         return zt_fail(err, ZT_ERR_ARGUMENT, "samples per pixel must be 1..16777216, not %d", o->spp);
     if (o->depth < 0 || o->depth > 1024)
@@ -35,17 +46,93 @@ static zt_status check_options(const zt_scene *scene, const zt_render_options *o
                        o->level, o->depth);
     if (o->threads < 0 || o->threads > 1024)
         return zt_fail(err, ZT_ERR_ARGUMENT, "threads must be 0..1024, not %d", o->threads);
+    if (!(o->cutoff >= 0))
+        return zt_fail(err, ZT_ERR_ARGUMENT, "cutoff must be a number >= 0");
+    if (o->quality < 0 || o->quality > 16)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "quality must be 0..16, not %d", o->quality);
     if (o->lights_off_count < 0 || o->lights_off_count > ZT_MAX_LIGHTS_OFF)
         return zt_fail(err, ZT_ERR_ARGUMENT, "too many lights switched off");
     for (int i = 0; i < o->lights_off_count; i++)
         if (o->lights_off[i] < 0 || o->lights_off[i] >= scene->light_count)
             return zt_fail(err, ZT_ERR_ARGUMENT,
-                           "cannot switch off light %d: the scene has %d light%s (0..%d)",
+                           "cannot switch off light %d: the scene has %d light%s",
                            o->lights_off[i], scene->light_count,
-                           scene->light_count == 1 ? "" : "s", scene->light_count - 1);
-    if (!scene->has_camera || scene->camera.width < 1 || scene->camera.height < 1)
-        return zt_fail(err, ZT_ERR_ARGUMENT, "the scene has no usable camera");
+                           scene->light_count == 1 ? "" : "s");
+    if (!scene->has_camera)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "the scene has no camera");
+    return check_camera(&scene->camera, err);
+}
+
+void zt_renderer_release(zt_renderer *r)
+{
+    if (!r)
+        return;
+    zone_release(r);
+    rscene_free(&r->rs);
+    zt_scene_release(r->scene);
+    free(r);
+}
+
+static zt_status renderer_create(const zt_scene *scene, const zt_render_options *o,
+                                 zt_renderer **out, zt_render_stats *stats,
+                                 zt_error *err)
+{
+    *out = NULL;
+    zt_status st = check_options(scene, o, err);
+    if (st != ZT_OK)
+        return st;
+    zt_renderer *r = calloc(1, sizeof *r);
+    if (!r || !(r->scene = zt_scene_clone(scene))) {
+        free(r);
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    }
+    r->options = *o;
+    st = rscene_build(&r->rs, r->scene, o->lights_off, o->lights_off_count,
+                      render_accel_kind(), err);
+    if (st == ZT_OK && o->method == ZT_METHOD_ZONE)
+        st = zone_prepare(r, stats, err);
+    if (st != ZT_OK) {
+        zt_renderer_release(r);
+        return st;
+    }
+    *out = r;
     return ZT_OK;
+}
+
+zt_status zt_renderer_create(const zt_scene *scene, const zt_render_options *o,
+                             zt_renderer **out, zt_error *err)
+{
+    return renderer_create(scene, o, out, NULL, err);
+}
+
+zt_status zt_renderer_set_camera(zt_renderer *r, const zt_camera *camera,
+                                 zt_error *err)
+{
+    zt_status st = check_camera(camera, err);
+    if (st != ZT_OK)
+        return st;
+    zt_scene_set_camera(r->scene, camera);
+    return ZT_OK;
+}
+
+zt_status zt_renderer_accumulate(zt_renderer *r, int first, int count, zt_image *sum,
+                                 zt_render_stats *stats, zt_error *err)
+{
+    zt_render_stats local;
+    if (!stats)
+        stats = &local;
+    if (sum->width != r->scene->camera.width || sum->height != r->scene->camera.height)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "accumulation image is %dx%d, the camera %dx%d",
+                       sum->width, sum->height, r->scene->camera.width,
+                       r->scene->camera.height);
+    if (first < 0 || count < 1)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "bad sample range %d+%d", first, count);
+    double t0 = render_clock();
+    zt_status st = r->options.method == ZT_METHOD_PATH
+                       ? path_accumulate(r, first, count, sum, stats, err)
+                       : zone_accumulate(r, sum, stats, err);
+    stats->seconds = render_clock() - t0;
+    return st;
 }
 
 zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
@@ -56,23 +143,30 @@ zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
         stats = &local;
     memset(stats, 0, sizeof *stats);
     *out = NULL;
-    zt_status st = check_options(scene, options, err);
+    double t0 = render_clock();
+    zt_renderer *r;
+    zt_status st = renderer_create(scene, options, &r, stats, err);
     if (st != ZT_OK)
         return st;
     zt_image *img = zt_image_create(scene->camera.width, scene->camera.height);
-    if (!img)
+    if (!img) {
+        zt_renderer_release(r);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for a %dx%d image",
                        scene->camera.width, scene->camera.height);
-    double t0 = render_clock();
-    if (options->method == ZT_METHOD_PATH)
-        st = render_path(scene, options, img, stats, err);
-    else
-        st = render_zone(scene, options, img, stats, err);
-    stats->seconds = render_clock() - t0;
+    }
+    st = zt_renderer_accumulate(r, 0, options->spp, img, stats, err);
+    zt_renderer_release(r);
     if (st != ZT_OK) {
         zt_image_release(img);
         return st;
     }
+    if (options->method == ZT_METHOD_PATH) {
+        float inv = 1.0f / (float)options->spp;
+        size_t n = (size_t)img->width * (size_t)img->height * 3;
+        for (size_t i = 0; i < n; i++)
+            img->pixels[i] *= inv;
+    }
+    stats->seconds = render_clock() - t0;
     *out = img;
     return ZT_OK;
 }

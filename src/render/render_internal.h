@@ -4,6 +4,7 @@
 
 #include "zonetrace/render.h"
 #include "scene/scene.h"
+#include "render/render_scene.h"
 
 /* Wall-clock seconds from an arbitrary origin. */
 double render_clock(void);
@@ -28,10 +29,24 @@ void progress_init(progress *p, const zt_render_options *o, const char *stage,
 /* Adds amount of finished work; thread-safe. */
 void progress_add(progress *p, double amount);
 
-zt_status render_path(const zt_scene *scene, const zt_render_options *o,
-                      zt_image *img, zt_render_stats *stats, zt_error *err);
-zt_status render_zone(const zt_scene *scene, const zt_render_options *o,
-                      zt_image *img, zt_render_stats *stats, zt_error *err);
+/* The state a renderer keeps between images. */
+struct zone_forest;
+struct zt_renderer {
+    zt_scene *scene;            /* the renderer's own copy */
+    zt_render_options options;
+    rscene rs;
+    struct zone_forest *forest; /* zone tracer only */
+};
+
+/* Adds path-traced samples first..first+count-1 of every pixel to sum. */
+zt_status path_accumulate(zt_renderer *r, int first, int count, zt_image *sum,
+                          zt_render_stats *stats, zt_error *err);
+
+/* Zone tracer: Phase One (on creation) and Phase Two (per image). */
+zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err);
+zt_status zone_accumulate(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
+                          zt_error *err);
+void zone_release(zt_renderer *r);
 
 /* The acceleration structure renderers use; ZT_ACCEL=brute in the
  * environment selects the brute-force oracle (for tests and benchmarks). */
