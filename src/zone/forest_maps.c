@@ -1,0 +1,241 @@
+/* Phase One, the light: irradiance maps of every diffuse surface, level by
+ * level.  Level 0 (direct light) is exact at every texel; level k >= 1
+ * gathers the level-k radiance arriving at the texel over a fixed set of
+ * cosine-distributed directions, the same set for every texel, so what error
+ * remains varies smoothly over a surface instead of appearing as noise. */
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "util/error.h"
+#include "zone/zone_internal.h"
+
+/* Bounds of the finite geometry and the camera, where planes need maps. */
+static void scene_bounds(const zt_scene *sc, vec3 *lo, vec3 *hi)
+{
+    *lo = v3(1e300, 1e300, 1e300);
+    *hi = v3(-1e300, -1e300, -1e300);
+    vec3 pts[8];
+    int n;
+    for (int i = 0; i < sc->part_count; i++) {
+        const part *p = &sc->parts[i];
+        n = 0;
+        if (p->shape == SHAPE_TRIANGLE) {
+            for (int k = 0; k < 3; k++)
+                pts[n++] = p->p[k];
+        } else if (p->shape == SHAPE_SPHERE) {
+            pts[n++] = v3_sub(p->p[0], v3(p->radius, p->radius, p->radius));
+            pts[n++] = v3_add(p->p[0], v3(p->radius, p->radius, p->radius));
+        } else if (p->shape == SHAPE_POINT) {
+            pts[n++] = p->p[0];
+        }
+        for (int k = 0; k < n; k++) {
+            *lo = v3(fmin(lo->x, pts[k].x), fmin(lo->y, pts[k].y), fmin(lo->z, pts[k].z));
+            *hi = v3(fmax(hi->x, pts[k].x), fmax(hi->y, pts[k].y), fmax(hi->z, pts[k].z));
+        }
+    }
+    const zt_camera *c = &sc->camera;
+    for (int k = 0; k < 5; k++) {
+        vec3 q = k < 4 ? v3_from(c->screen[k]) : v3_from(c->viewpoint);
+        *lo = v3(fmin(lo->x, q.x), fmin(lo->y, q.y), fmin(lo->z, q.z));
+        *hi = v3(fmax(hi->x, q.x), fmax(hi->y, q.y), fmax(hi->z, q.z));
+    }
+}
+
+static int clampi(double v, int lo, int hi)
+{
+    int i = (int)ceil(v);
+    return i < lo ? lo : i > hi ? hi : i;
+}
+
+static void plane_layout(const part *p, vec3 lo, vec3 hi, double texel, map_layout *l)
+{
+    vec3 n = p->normal;
+    vec3 a = fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0);
+    vec3 u = v3_normalize(v3_cross(a, n)), v = v3_cross(n, u);
+    vec3 base = v3_scale(n, p->offset);
+    double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
+    for (int k = 0; k < 8; k++) {
+        vec3 c = v3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
+        vec3 d = v3_sub(c, base);
+        umin = fmin(umin, v3_dot(d, u));
+        umax = fmax(umax, v3_dot(d, u));
+        vmin = fmin(vmin, v3_dot(d, v));
+        vmax = fmax(vmax, v3_dot(d, v));
+    }
+    double mu = 0.1 * (umax - umin), mv = 0.1 * (vmax - vmin);
+    umin -= mu; umax += mu; vmin -= mv; vmax += mv;
+    /* du x dv must point along the normal. */
+    l->origin = v3_add(base, v3_add(v3_scale(u, umin), v3_scale(v, vmin)));
+    l->du = v3_scale(u, umax - umin);
+    l->dv = v3_scale(v, vmax - vmin);
+    l->nu = clampi((umax - umin) / texel, 2, 256);
+    l->nv = clampi((vmax - vmin) / texel, 2, 256);
+}
+
+static void layout_part(const zt_scene *sc, int i, vec3 lo, vec3 hi, double texel,
+                        map_layout *l)
+{
+    const part *p = &sc->parts[i];
+    memset(l, 0, sizeof *l);
+    l->shape = p->shape;
+    l->sides = sc->objects[p->object].backculled ? 1 : 2;
+    if (p->shape == SHAPE_TRIANGLE) {
+        l->origin = p->p[0];
+        l->du = v3_sub(p->p[1], p->p[0]);
+        l->dv = v3_sub(p->p[2], p->p[0]);
+        l->nu = clampi(v3_length(l->du) / texel, 2, 128);
+        l->nv = clampi(v3_length(l->dv) / texel, 2, 128);
+    } else if (p->shape == SHAPE_SPHERE) {
+        l->centre = p->p[0];
+        l->radius = p->radius;
+        l->nv = clampi(3.14159265358979 * p->radius / texel, 4, 96);
+        l->nu = 2 * l->nv;
+    } else {
+        plane_layout(p, lo, hi, texel, l);
+    }
+}
+
+/* A fixed cosine-weighted direction set: a Hammersley point set through
+ * the disk-to-hemisphere map. */
+static vec3 *gather_directions(int n)
+{
+    vec3 *d = malloc((size_t)n * sizeof *d);
+    if (!d)
+        return NULL;
+    for (int i = 0; i < n; i++) {
+        uint32_t b = (uint32_t)i;
+        b = (b << 16) | (b >> 16);
+        b = ((b & 0x55555555u) << 1) | ((b & 0xAAAAAAAAu) >> 1);
+        b = ((b & 0x33333333u) << 2) | ((b & 0xCCCCCCCCu) >> 2);
+        b = ((b & 0x0F0F0F0Fu) << 4) | ((b & 0xF0F0F0F0u) >> 4);
+        b = ((b & 0x00FF00FFu) << 8) | ((b & 0xFF00FF00u) >> 8);
+        double u1 = (i + 0.5) / n, u2 = b * (1.0 / 4294967296.0);
+        double r = sqrt(u1), phi = 2 * 3.14159265358979 * u2;
+        d[i] = v3(r * cos(phi), r * sin(phi), sqrt(fmax(0.0, 1.0 - u1)));
+    }
+    return d;
+}
+
+static void frame(vec3 n, vec3 *t, vec3 *b)
+{
+    vec3 a = fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0);
+    *t = v3_normalize(v3_cross(a, n));
+    *b = v3_cross(n, *t);
+}
+
+static vec3f to_f(vec3 v) { return f3((float)v.x, (float)v.y, (float)v.z); }
+
+/* One texel of one level and side. */
+static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int level,
+                        vec3 x, vec3 n, const vec3 *dirs)
+{
+    const rscene *rs = &t->r->rs;
+    vec3 e = v3(0, 0, 0);
+    if (level == 0) {
+        for (int i = 0; i < rs->part_count; i++) {
+            const rs_part *lp = &rs->parts[i];
+            if (!lp->is_light || f3_is_black(rs->objects[lp->object].emission))
+                continue;
+            vec3f em = rs->objects[lp->object].emission;
+            double g = direct_irradiance(&f->direct, i, x, n, part_index);
+            e = v3_add(e, v3_scale(v3(em.x, em.y, em.z), g));
+        }
+        if (f3_is_black(rs->sky))
+            return e;
+    }
+    /* Gather: E = pi * mean of the radiance over cosine-distributed
+     * directions (for level 0 only the sky's share is gathered). */
+    vec3 tt, bb;
+    frame(n, &tt, &bb);
+    vec3f o = ray_offset(to_f(x), to_f(n));
+    vec3 sum = v3(0, 0, 0);
+    for (int k = 0; k < f->q.gather; k++) {
+        vec3 d = v3_add(v3_add(v3_scale(tt, dirs[k].x), v3_scale(bb, dirs[k].y)),
+                        v3_scale(n, dirs[k].z));
+        vec3 l;
+        if (level == 0) {
+            hit h = accel_intersect(rs, o, to_f(d));
+            t->rays++;
+            l = h.part < 0 ? v3(rs->sky.x, rs->sky.y, rs->sky.z) : v3(0, 0, 0);
+        } else {
+            l = zone_radiance(t, o, to_f(v3_normalize(d)), level, level, 0, NULL, 0);
+        }
+        sum = v3_add(sum, l);
+    }
+    return v3_add(e, v3_scale(sum, 3.14159265358979 / f->q.gather));
+}
+
+zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
+{
+    const zt_scene *sc = r->scene;
+    int depth = r->options.level >= 0 ? r->options.level : r->options.depth;
+    f->map_levels = depth - 1 > 0 ? depth - 1 : 0;
+    f->maps = calloc((size_t)sc->part_count + 1, sizeof(part_map));
+    if (!f->maps)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
+    f->map_count = sc->part_count;
+    if (f->map_levels == 0)
+        return ZT_OK;
+    vec3 lo, hi;
+    scene_bounds(sc, &lo, &hi);
+    for (int i = 0; i < sc->part_count; i++) {
+        const object *o = &sc->objects[sc->parts[i].object];
+        if (o->is_light || o->mat.weight[LOBE_DIFFUSE] <= 0)
+            continue;
+        part_map *m = &f->maps[i];
+        layout_part(sc, i, lo, hi, f->q.texel, &m->layout);
+        m->levels = f->map_levels;
+        size_t n = (size_t)m->levels * (size_t)m->layout.sides * (size_t)m->layout.nu *
+                   (size_t)m->layout.nv * 3;
+        m->texels = calloc(n, sizeof(float));
+        if (!m->texels)
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
+    }
+    vec3 *dirs = gather_directions(f->q.gather);
+    if (!dirs)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    int threads = render_thread_count(r->options.threads);
+    uint64_t rays = 0;
+    for (int level = 0; level < f->map_levels; level++) {
+        /* One work item per texel row of every map and side. */
+        for (int i = 0; i < sc->part_count; i++) {
+            part_map *m = &f->maps[i];
+            if (!m->texels)
+                continue;
+            int rows = m->layout.nv * m->layout.sides;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays)
+            for (int row = 0; row < rows; row++) {
+                zone_trace t = {f, r, 0};
+                int side = row / m->layout.nv, j = row % m->layout.nv;
+                for (int u = 0; u < m->layout.nu; u++) {
+                    vec3 x, n;
+                    map_texel_point(&m->layout, u, j, &x, &n);
+                    if (side)
+                        n = v3_scale(n, -1);
+                    vec3 e = texel_value(&t, f, i, level, x, n, dirs);
+                    float *px = map_texel(m, level, side, u, j);
+                    px[0] = (float)e.x;
+                    px[1] = (float)e.y;
+                    px[2] = (float)e.z;
+                }
+                rays += t.rays;
+            }
+        }
+    }
+    f->rays += rays;
+    free(dirs);
+    return ZT_OK;
+}
+
+void forest_free(zone_forest *f)
+{
+    if (f->maps)
+        for (int i = 0; i < f->map_count; i++)
+            free(f->maps[i].texels);
+    free(f->maps);
+    free(f->zones);
+    free(f->occluders);
+}

@@ -1,0 +1,79 @@
+/* The zone tracer's state: the forest of zones grown from the lights
+ * (Phase One) and what Phase Two reads from it. */
+#ifndef ZT_ZONE_ZONE_INTERNAL_H
+#define ZT_ZONE_ZONE_INTERNAL_H
+
+#include <stdint.h>
+
+#include "render/render_internal.h"
+#include "zone/direct.h"
+#include "zone/zone_maps.h"
+
+/* How light leaves a zone's source. */
+typedef enum zone_kind {
+    ZONE_EMIT = 0,      /* a root: the light part itself */
+    ZONE_DIFFUSE,
+    ZONE_METALLIC,
+    ZONE_MIRROR,
+    ZONE_REFRACT,       /* the dielectric lobe: reflected and transmitted */
+    ZONE_KINDS
+} zone_kind;
+
+/* One zone: the light leaving `source` by `kind`, having arrived along the
+ * branch of its parent.  Diffuse zones of one level on one surface share
+ * that surface's irradiance map (their light is the map's value). */
+typedef struct zone {
+    int parent;         /* -1 for roots */
+    int source;         /* part the light leaves */
+    int root_light;     /* light part at the root of the tree */
+    uint8_t kind;       /* zone_kind */
+    uint8_t level;      /* scattering events so far (0 at the root) */
+    float power;        /* bound on the power carried, for --cutoff */
+    int first_child, child_count;
+    int first_occluder, occluder_count; /* parts that can shadow it */
+} zone;
+
+/* Quality settings derived from --quality. */
+typedef struct zone_quality {
+    int gather;         /* directions per texel for indirect maps */
+    double texel;       /* target texel size in scene units */
+    int sides;          /* polygon vertices for disks */
+    int aa;             /* sub-pixel grid per side */
+} zone_quality;
+
+typedef struct zone_forest {
+    zone *zones;
+    int zone_count, zone_capacity;
+    int *occluders;     /* occluder lists of all zones */
+    int occluder_count, occluder_capacity;
+    uint64_t pruned;
+    part_map *maps;     /* per part (only diffuse things have texels) */
+    int map_count;
+    int map_levels;     /* irradiance levels E_0 .. E_{map_levels-1} */
+    direct_ctx direct;
+    zone_quality q;
+    double phase_one_seconds;
+    uint64_t rays;
+} zone_forest;
+
+/* Phase One pieces. */
+zt_status forest_build_tree(zone_forest *f, const zt_renderer *r, zt_error *err);
+zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err);
+void forest_free(zone_forest *f);
+
+/* Radiance arriving along a ray with levels lo..hi (flags below). */
+typedef struct zone_trace {
+    const zone_forest *f;
+    const zt_renderer *r;
+    uint64_t rays;
+} zone_trace;
+
+enum {
+    ZR_EXACT_DIRECT = 1, /* level 1 from the analytic direct term, not maps */
+    ZR_NO_EMISSION = 2   /* lights hit by this very ray count nothing (the
+                            camera's level 0 is measured analytically) */
+};
+vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
+                   int flags, const int *media, int media_count);
+
+#endif

@@ -1,0 +1,125 @@
+/* Radiance by level along a ray, from the forest:
+ *   level 0      lights (and sky) seen directly;
+ *   level 1      diffuse: rho/pi * exact direct irradiance (camera paths) or
+ *                the level-0 map (gathers);
+ *   level l >= 2 diffuse: rho/pi * the level l-1 irradiance map;
+ *   specular lobes (mirror, metal, glass) pass the levels below theirs on
+ *   along the reflected and refracted rays, deterministically: the glass
+ *   lobe follows both the reflected and the transmitted ray. */
+#include "zone/zone_internal.h"
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "geom/shapes.h"
+#include "light/light_sample.h"
+#include "material/bsdf.h"
+
+#define MEDIA_MAX 8
+
+static vec3 to_d(vec3f v) { return v3(v.x, v.y, v.z); }
+
+static vec3 direct_light(zone_trace *t, int receiver, vec3 x, vec3 n)
+{
+    const rscene *rs = &t->r->rs;
+    vec3 e = v3(0, 0, 0);
+    for (int i = 0; i < rs->part_count; i++) {
+        const rs_part *lp = &rs->parts[i];
+        if (!lp->is_light)
+            continue;
+        vec3f em = rs->objects[lp->object].emission;
+        if (f3_is_black(em))
+            continue;
+        double g = direct_irradiance(&t->f->direct, i, x, n, receiver);
+        e = v3_add(e, v3_scale(to_d(em), g));
+    }
+    return e;
+}
+
+
+vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
+                   int flags, const int *media, int media_count)
+{
+    int exact_direct = flags & ZR_EXACT_DIRECT;
+    if (hi < 0 || lo > hi)
+        return v3(0, 0, 0);
+    const rscene *rs = &t->r->rs;
+    hit h = accel_intersect(rs, o, d);
+    t->rays++;
+    if (h.part < 0)
+        return lo <= 0 ? to_d(rs->sky) : v3(0, 0, 0);
+    const rs_part *p = &rs->parts[h.part];
+    vec3f xf = f3_madd(o, d, h.t);
+    if (p->is_light)
+        return lo <= 0 && !(flags & ZR_NO_EMISSION) ? to_d(light_emitted(rs, p, xf, d))
+                                                     : v3(0, 0, 0);
+    if (hi < 1)
+        return v3(0, 0, 0);
+
+    const rs_object *m = &rs->objects[p->object];
+    vec3f ngf = shape_normal(p, xf);
+    int back = f3_dot(ngf, d) > 0.0f;
+    vec3f nf = back ? f3_neg(ngf) : ngf;
+    vec3 x = to_d(xf), n = to_d(nf), color = to_d(m->color);
+    vec3 out = v3(0, 0, 0);
+
+    if (m->weight[LOBE_DIFFUSE] > 0.0f) {
+        vec3 e = v3(0, 0, 0);
+        const part_map *pm = &t->f->maps[h.part];
+        for (int l = lo > 1 ? lo : 1; l <= hi; l++) {
+            if (l == 1 && exact_direct) {
+                /* Exact direct light from the lights; the sky's share
+                 * (a gathered quantity) is the level-0 map minus that. */
+                e = v3_add(e, direct_light(t, h.part, x, n));
+            } else if (l - 1 < t->f->map_levels) {
+                e = v3_add(e, map_lookup(pm, l - 1, back, x));
+            }
+        }
+        out = v3_add(out, v3_scale(v3_mul(color, e), m->weight[LOBE_DIFFUSE] / 3.14159265358979));
+    }
+
+    float wm = m->weight[LOBE_METALLIC], wr = m->weight[LOBE_REFLECTING];
+    float wt = m->weight[LOBE_REFRACTIVE];
+    if (hi >= 1 && (wm > 0.0f || wr > 0.0f || wt > 0.0f)) {
+        vec3f wo = f3_neg(d);
+        float cos_o = f3_dot(nf, wo);
+        vec3f refl = f3_normalize(f3_sub(d, f3_scale(nf, 2.0f * f3_dot(d, nf))));
+        vec3f out_o = ray_offset(xf, nf);
+        double k_refl = wr;
+        if (wm > 0.0f)
+            k_refl += wm * bsdf_schlick(cos_o, m->ior);
+        double k_tran = 0;
+        int entering = media_count == 0 || media[media_count - 1] != p->object;
+        float eta_i = media_count ? rs->objects[media[media_count - 1]].ior : 1.0f;
+        float eta_t = entering ? m->ior
+                               : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
+        if (wt > 0.0f) {
+            float fr = bsdf_fresnel_dielectric(cos_o, eta_i, eta_t);
+            k_refl += wt * fr;
+            k_tran = wt * (1.0 - fr);
+        }
+        if (k_refl > 0) {
+            vec3 l = zone_radiance(t, out_o, refl, lo - 1, hi - 1, exact_direct, media, media_count);
+            out = v3_add(out, v3_scale(v3_mul(color, l), k_refl));
+        }
+        if (k_tran > 0) {
+            float eta = eta_i / eta_t;
+            float sin2 = eta * eta * (1.0f - cos_o * cos_o);
+            float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+            vec3f tr = f3_normalize(f3_sub(f3_scale(d, eta), f3_scale(nf, cos_t - eta * cos_o)));
+            int next[MEDIA_MAX];
+            int nc = media_count;
+            for (int i = 0; i < nc && i < MEDIA_MAX; i++)
+                next[i] = media[i];
+            if (entering) {
+                if (nc < MEDIA_MAX)
+                    next[nc++] = p->object;
+            } else {
+                nc--;
+            }
+            vec3 l = zone_radiance(t, ray_offset(xf, f3_neg(nf)), tr, lo - 1, hi - 1,
+                                   exact_direct, next, nc);
+            out = v3_add(out, v3_scale(v3_mul(color, l), k_tran * eta * eta));
+        }
+    }
+    return out;
+}
