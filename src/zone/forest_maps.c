@@ -9,6 +9,7 @@
 
 #include "geom/accel.h"
 #include "geom/ray_offset.h"
+#include "geom/shapes.h"
 #include "util/error.h"
 #include "zone/zone_internal.h"
 
@@ -152,6 +153,8 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
     frame(n, &tt, &bb);
     vec3f o = ray_offset(to_f(x), to_f(n));
     vec3 sum = v3(0, 0, 0);
+    /* Each direction stands for a cone of solid angle about 2 pi / N. */
+    t->cone = (float)sqrt(2.0 / f->q.gather);
     for (int k = 0; k < f->q.gather; k++) {
         vec3 d = v3_add(v3_add(v3_scale(tt, dirs[k].x), v3_scale(bb, dirs[k].y)),
                         v3_scale(n, dirs[k].z));
@@ -165,14 +168,53 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
         }
         sum = v3_add(sum, l);
     }
+    t->cone = 0.0f;
     return v3_add(e, v3_scale(sum, 3.14159265358979 / f->q.gather));
+}
+
+/* Whether a texel centre lies on a surface light can reach: from inside a
+ * closed object, or from outside a room of culled walls, most directions
+ * first meet the back of a culled surface. */
+static float texel_weight(const rscene *rs, int own, vec3 x, vec3 n, const vec3 *dirs, int ndirs)
+{
+    vec3 t, b;
+    frame(n, &t, &b);
+    vec3f o = ray_offset(to_f(x), to_f(n));
+    int inside = 0, step = ndirs / 8 > 0 ? ndirs / 8 : 1, count = 0;
+    for (int k = 0; k < ndirs; k += step) {
+        vec3 dd = v3_add(v3_add(v3_scale(t, dirs[k].x), v3_scale(b, dirs[k].y)), v3_scale(n, dirs[k].z));
+        vec3f d = to_f(v3_normalize(dd));
+        float best = 1e30f;
+        int hit_part = -1;
+        for (int i = 0; i < rs->part_count; i++) {
+            if (i == own)
+                continue;
+            rs_part p = rs->parts[i];
+            p.culled = 0;
+            float th = shape_hit(&p, o, d, 0.0f, best);
+            if (th > 0.0f) {
+                best = th;
+                hit_part = i;
+            }
+        }
+        count++;
+        if (hit_part >= 0) {
+            const rs_part *p = &rs->parts[hit_part];
+            vec3f hn = shape_normal(p, f3_madd(o, d, best));
+            if (p->culled && f3_dot(hn, d) > 0.0f)
+                inside++;
+        }
+    }
+    return 2 * inside >= count ? 0.0f : 1.0f;
 }
 
 zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
 {
     const zt_scene *sc = r->scene;
     int depth = r->options.level >= 0 ? r->options.level : r->options.depth;
-    f->map_levels = depth - 1 > 0 ? depth - 1 : 0;
+    /* Pixel level L reads E_{L-1}; level 1 is exact, so maps are needed
+     * from depth 2 on, and then all of E_0 .. E_{depth-1}. */
+    f->map_levels = depth >= 2 ? depth : 0;
     f->maps = calloc((size_t)sc->part_count + 1, sizeof(part_map));
     if (!f->maps)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
@@ -191,12 +233,31 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
         size_t n = (size_t)m->levels * (size_t)m->layout.sides * (size_t)m->layout.nu *
                    (size_t)m->layout.nv * 3;
         m->texels = calloc(n, sizeof(float));
-        if (!m->texels)
+        m->weight[0] = calloc((size_t)m->layout.sides * m->layout.nu * m->layout.nv, sizeof(float));
+        if (!m->texels || !m->weight[0])
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
     }
     vec3 *dirs = gather_directions(f->q.gather);
     if (!dirs)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    for (int i = 0; i < sc->part_count; i++) {
+        part_map *m = &f->maps[i];
+        if (!m->texels)
+            continue;
+        int rows = m->layout.nv * m->layout.sides;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(render_thread_count(r->options.threads))
+        for (int row = 0; row < rows; row++) {
+            int side = row / m->layout.nv, j = row % m->layout.nv;
+            for (int u = 0; u < m->layout.nu; u++) {
+                vec3 x, n;
+                map_texel_point(&m->layout, u, j, &x, &n);
+                if (side)
+                    n = v3_scale(n, -1);
+                m->weight[0][((size_t)side * m->layout.nv + j) * m->layout.nu + u] =
+                    texel_weight(&r->rs, i, x, n, dirs, f->q.gather);
+            }
+        }
+    }
     int threads = render_thread_count(r->options.threads);
     uint64_t rays = 0;
     for (int level = 0; level < f->map_levels; level++) {
@@ -208,7 +269,7 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
             int rows = m->layout.nv * m->layout.sides;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays)
             for (int row = 0; row < rows; row++) {
-                zone_trace t = {f, r, 0};
+                zone_trace t = {f, r, 0, 0.0f};
                 int side = row / m->layout.nv, j = row % m->layout.nv;
                 for (int u = 0; u < m->layout.nu; u++) {
                     vec3 x, n;
@@ -223,6 +284,10 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                 }
                 rays += t.rays;
             }
+            if (!map_build_mips(m, level)) {
+                free(dirs);
+                return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
+            }
         }
     }
     f->rays += rays;
@@ -234,7 +299,7 @@ void forest_free(zone_forest *f)
 {
     if (f->maps)
         for (int i = 0; i < f->map_count; i++)
-            free(f->maps[i].texels);
+            map_free(&f->maps[i]);
     free(f->maps);
     free(f->zones);
     free(f->occluders);

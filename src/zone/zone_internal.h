@@ -66,6 +66,7 @@ typedef struct zone_trace {
     const zone_forest *f;
     const zt_renderer *r;
     uint64_t rays;
+    float cone;         /* angular radius a gather ray stands for (0: exact) */
 } zone_trace;
 
 enum {

@@ -19,11 +19,21 @@ typedef struct map_layout {
     int sides;          /* 1 (front only) or 2 */
 } map_layout;
 
-/* The grid of one part: texel values for each level and side. */
+#define MAP_MIPS 8
+
+/* The grid of one part: texel values for each level and side, and coarser
+ * copies (each halving the resolution) for lookups that stand for a wide
+ * cone of directions. */
 typedef struct part_map {
     map_layout layout;
     int levels;         /* levels stored: 0 .. levels-1 */
     float *texels;      /* [level][side][v][u][rgb] */
+    int mips;           /* coarser copies in mip[1..mips-1] (mip[0] = texels) */
+    float *mip[MAP_MIPS];
+    /* Per texel and side, the share of it that lies on a reachable surface
+     * (0 for texel centres inside closed objects or outside the room); the
+     * same for every level.  weight[0] is the grid's, the rest the copies'. */
+    float *weight[MAP_MIPS];
 } part_map;
 
 /* Texel centre (i, j) of the layout as a point and the surface normal. */
@@ -34,6 +44,16 @@ void map_coords(const map_layout *l, vec3 p, double *u, double *v);
 
 /* The value of a level and side at point p, interpolated. */
 vec3 map_lookup(const part_map *m, int level, int side, vec3 p);
+
+/* Builds the coarser copies of one level (after its texels are final).
+ * The first call also builds the coarser weights from weight[0]. */
+int map_build_mips(part_map *m, int level);
+
+/* Like map_lookup, averaged over a footprint of about `width` scene units
+ * (0: the finest grid). */
+vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double width);
+
+void map_free(part_map *m);
 
 static inline float *map_texel(const part_map *m, int level, int side, int i, int j)
 {

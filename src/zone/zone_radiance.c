@@ -71,7 +71,12 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                  * (a gathered quantity) is the level-0 map minus that. */
                 e = v3_add(e, direct_light(t, h.part, x, n));
             } else if (l - 1 < t->f->map_levels) {
-                e = v3_add(e, map_lookup(pm, l - 1, back, x));
+                /* A gather ray's value is an average over its cone's
+                 * footprint: read the map at that width. */
+                double width = 0;
+                if (t->cone > 0.0f)
+                    width = 2.0 * t->cone * h.t / fmax(0.2, fabs(f3_dot(d, ngf)));
+                e = v3_add(e, map_lookup_wide(pm, l - 1, back, x, width));
             }
         }
         out = v3_add(out, v3_scale(v3_mul(color, e), m->weight[LOBE_DIFFUSE] / 3.14159265358979));

@@ -28,6 +28,10 @@ static zone_quality quality_for(const zt_scene *sc, int q)
     z.texel = extent / (12.0 * pow(sqrt(2.0), q));
     z.sides = 16 << (q / 2);
     z.aa = q < 2 ? 1 : 2;
+    if (getenv("ZT_ZONE_GATHER"))
+        z.gather = atoi(getenv("ZT_ZONE_GATHER"));
+    if (getenv("ZT_ZONE_TEXEL"))
+        z.texel = extent / atof(getenv("ZT_ZONE_TEXEL"));
     return z;
 }
 
@@ -239,7 +243,7 @@ zt_status zone_accumulate(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
     for (int y = 0; y < sum->height; y++) {
         if (prog.cancelled)
             continue;
-        zone_trace t = {f, r, 0};
+        zone_trace t = {f, r, 0, 0.0f};
         /* Signatures at the pixel corners of this row (top and bottom). */
         uint32_t *corner = malloc(2 * ((size_t)sum->width + 1) * sizeof *corner);
         int *corner_part = malloc(2 * ((size_t)sum->width + 1) * sizeof *corner_part);
