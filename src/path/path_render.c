@@ -23,7 +23,8 @@ zt_status path_accumulate(zt_renderer *r, int first, int count, zt_image *sum,
     path_params pp;
     pp.min_level = o->level >= 0 ? o->level : 0;
     pp.max_level = o->level >= 0 ? o->level : o->depth;
-    pp.seed = (uint32_t)(o->seed ^ (o->seed >> 32));
+    /* Both halves of the 64-bit seed matter. */
+    pp.seed = sampler_hash((uint32_t)o->seed ^ sampler_hash((uint32_t)(o->seed >> 32) + 0x9e3779b9U));
 
     int tiles_x = (sum->width + TILE - 1) / TILE;
     int tiles_y = (sum->height + TILE - 1) / TILE;

@@ -104,7 +104,14 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             if (bsdf_pdf > 0.0f && !f3_is_black(ls.li)) {
                 (*rays)++;
                 const rs_part *lp = &rs->parts[ls.part];
-                if (!accel_occluded(rs, x_out, ls.wi, ls.dist * 0.9999f, lp->background)) {
+                /* Aim the shadow ray from the offset origin at the sampled
+                 * point itself: near a sphere's rim, keeping the direction
+                 * and distance measured from x would graze the light and
+                 * find it blocking itself. */
+                vec3f to_y = f3_sub(f3_madd(x, ls.wi, ls.dist), x_out);
+                float dist_y = f3_length(to_y);
+                vec3f dir_y = f3_scale(to_y, 1.0f / dist_y);
+                if (!accel_occluded(rs, x_out, dir_y, dist_y * 0.9999f, lp->background)) {
                     float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
                     radiance = f3_add(radiance,
                                       f3_scale(f3_mul(f3_mul(beta, fcos), ls.li), w / ls.pdf));
