@@ -6,49 +6,52 @@
 #include "geom/shapes.h"
 
 /* Planes: t = (offset - n.o) / (n.d), valid in (0, tmax) and, for culled
- * planes, only from the front.  The distances are computed for all planes
- * first (independent divisions, which pipeline and vectorise) and reduced
- * after; a failed division (n.d = 0) gives inf or nan, which compare false. */
-#define PLANE_BATCH 16
-
-static int plane_distances(const rs_plane *pl, int n, vec3f o, vec3f d,
-                           float *t)
+ * planes, only from the front.  All planes of a layer are computed at once
+ * in fixed-width blocks the compiler turns into vector code; a failed
+ * division (n.d = 0) gives inf or nan, which compare false. */
+static inline void plane_block(const rs_planes *pl, int base, vec3f o, vec3f d,
+                               float *restrict t)
 {
-    for (int i = 0; i < n; i++) {
-        float dn = d.x * pl[i].n.x + d.y * pl[i].n.y + d.z * pl[i].n.z;
-        float num = pl[i].offset - (o.x * pl[i].n.x + o.y * pl[i].n.y + o.z * pl[i].n.z);
-        float ti = num / dn;
-        t[i] = (pl[i].culled && dn >= 0.0f) ? -1.0f : ti;
-    }
-    return n;
-}
-
-static void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d,
-                           hit *h)
-{
-    const rs_plane *pl = rs->planes[layer];
-    float t[PLANE_BATCH];
-    for (int start = 0; start < rs->plane_count[layer]; start += PLANE_BATCH) {
-        int n = rs->plane_count[layer] - start;
-        n = plane_distances(pl + start, n < PLANE_BATCH ? n : PLANE_BATCH, o, d, t);
-        for (int i = 0; i < n; i++)
-            if (t[i] > 0.0f && t[i] < h->t) {
-                h->t = t[i];
-                h->part = pl[start + i].part;
-            }
+    const float *restrict nx = pl->nx + base, *restrict ny = pl->ny + base;
+    const float *restrict nz = pl->nz + base, *restrict off = pl->offset + base;
+    const float *restrict cull = pl->culled + base;
+    for (int i = 0; i < PLANE_LANES; i++) {
+        float dn = d.x * nx[i] + d.y * ny[i] + d.z * nz[i];
+        float on = o.x * nx[i] + o.y * ny[i] + o.z * nz[i];
+        float ti = (off[i] - on) / dn;
+        /* Culled planes seen from behind: no hit.  Arithmetic instead of a
+         * branch keeps the loop vectorisable (inf/nan still compare false). */
+        float m = (float)((cull[i] > 0.0f) & (dn >= 0.0f));
+        t[i] = ti * (1.0f - m) - m;
     }
 }
 
-static int planes_any(const rscene *rs, int layer, vec3f o, vec3f d,
-                      float tmax)
+static void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d, hit *h)
 {
-    const rs_plane *pl = rs->planes[layer];
-    float t[PLANE_BATCH];
-    for (int start = 0; start < rs->plane_count[layer]; start += PLANE_BATCH) {
-        int n = rs->plane_count[layer] - start;
-        n = plane_distances(pl + start, n < PLANE_BATCH ? n : PLANE_BATCH, o, d, t);
+    const rs_planes *pl = &rs->planes[layer];
+    float t[PLANE_LANES];
+    float best = h->t;
+    int part = h->part;
+    for (int base = 0; base < pl->padded; base += PLANE_LANES) {
+        plane_block(pl, base, o, d, t);
+        for (int i = 0; i < PLANE_LANES; i++) {
+            int better = t[i] > 0.0f && t[i] < best;
+            best = better ? t[i] : best;
+            part = better ? pl->part[base + i] : part;
+        }
+    }
+    h->t = best;
+    h->part = part;
+}
+
+static int planes_any(const rscene *rs, int layer, vec3f o, vec3f d, float tmax)
+{
+    const rs_planes *pl = &rs->planes[layer];
+    float t[PLANE_LANES];
+    for (int base = 0; base < pl->padded; base += PLANE_LANES) {
+        plane_block(pl, base, o, d, t);
         int any = 0;
-        for (int i = 0; i < n; i++)
+        for (int i = 0; i < PLANE_LANES; i++)
             any |= t[i] > 0.0f && t[i] < tmax;
         if (any)
             return 1;

@@ -63,6 +63,30 @@ static void fill_part(rs_part *rp, const part *p, const object *o)
     }
 }
 
+/* Room for the layer's planes; the padding planes (normal 0, offset 1)
+ * give t = inf and are never hit. */
+static int planes_alloc(rs_planes *pl, const zt_scene *scene, int layer)
+{
+    int n = 0;
+    for (int i = 0; i < scene->part_count; i++)
+        n += scene->parts[i].shape == SHAPE_PLANE &&
+             scene->objects[scene->parts[i].object].background == layer;
+    pl->count = 0;
+    pl->padded = (n + PLANE_LANES - 1) / PLANE_LANES * PLANE_LANES;
+    size_t m = (size_t)pl->padded + 1;
+    pl->nx = calloc(5 * m, sizeof(float));
+    pl->part = calloc(m, sizeof(int));
+    if (!pl->nx || !pl->part)
+        return 0;
+    pl->ny = pl->nx + m;
+    pl->nz = pl->ny + m;
+    pl->offset = pl->nz + m;
+    pl->culled = pl->offset + m;
+    for (int i = 0; i < pl->padded; i++)
+        pl->offset[i] = 1.0f;
+    return 1;
+}
+
 zt_status rscene_build(rscene *rs, const zt_scene *scene,
                        const int *lights_off, int lights_off_count,
                        int accel_choice, zt_error *err)
@@ -73,9 +97,10 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
     rs->parts = calloc((size_t)(scene->part_count + 1), sizeof(rs_part));
     rs->objects = calloc((size_t)(scene->object_count + 1), sizeof(rs_object));
     rs->lights = calloc((size_t)(scene->part_count + 1), sizeof(rs_light));
+    int planes_ok = 1;
     for (int l = 0; l < 2; l++)
-        rs->planes[l] = calloc((size_t)(scene->part_count + 1), sizeof(rs_plane));
-    if (!rs->parts || !rs->objects || !rs->lights || !rs->planes[0] || !rs->planes[1]) {
+        planes_ok &= planes_alloc(&rs->planes[l], scene, l);
+    if (!rs->parts || !rs->objects || !rs->lights || !planes_ok) {
         rscene_free(rs);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     }
@@ -101,11 +126,14 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
         rs_part *rp = &rs->parts[i];
         fill_part(rp, p, &scene->objects[p->object]);
         if (rp->shape == SHAPE_PLANE) {
-            rs_plane *pl = &rs->planes[rp->background][rs->plane_count[rp->background]++];
-            pl->n = rp->n;
-            pl->offset = rp->offset;
-            pl->part = i;
-            pl->culled = rp->culled;
+            rs_planes *pl = &rs->planes[rp->background];
+            int k = pl->count++;
+            pl->nx[k] = rp->n.x;
+            pl->ny[k] = rp->n.y;
+            pl->nz[k] = rp->n.z;
+            pl->offset[k] = rp->offset;
+            pl->culled[k] = rp->culled ? 1.0f : 0.0f;
+            pl->part[k] = i;
         }
         double power = rp->is_light ? part_power(rp, &rs->objects[rp->object]) : 0;
         if (power > 0) {
@@ -138,7 +166,9 @@ void rscene_free(rscene *rs)
     free(rs->parts);
     free(rs->objects);
     free(rs->lights);
-    free(rs->planes[0]);
-    free(rs->planes[1]);
+    for (int l = 0; l < 2; l++) {
+        free(rs->planes[l].nx);
+        free(rs->planes[l].part);
+    }
     memset(rs, 0, sizeof *rs);
 }

@@ -44,12 +44,16 @@ typedef struct rs_light {
     float select_cdf;   /* cumulative, for the choice */
 } rs_light;
 
-typedef struct rs_plane {
-    vec3f n;
-    float offset;
-    int part;
-    int culled;
-} rs_plane;
+/* The infinite planes of one layer as arrays (one entry per plane, padded
+ * to a multiple of PLANE_LANES with planes that are never hit), so that a
+ * ray meets all of them in a few vector instructions. */
+#define PLANE_LANES 8
+typedef struct rs_planes {
+    int count, padded;
+    float *nx, *ny, *nz, *offset;
+    float *culled;   /* 1 for culled planes, else 0 */
+    int *part;
+} rs_planes;
 
 typedef struct rscene {
     rs_part *parts;
@@ -61,8 +65,7 @@ typedef struct rscene {
     /* Infinite planes of each layer ([0] foreground, [1] background), kept
      * apart from the other primitives as compact arrays: they are tested
      * against every ray. */
-    rs_plane *planes[2];
-    int plane_count[2];
+    rs_planes planes[2];
     vec3f sky;
     struct accel *accel;
 } rscene;

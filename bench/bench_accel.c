@@ -1,0 +1,329 @@
+/* Acceleration backends compared: build time and million rays per second
+ * for nearest-hit and visibility queries, on one thread and on all, for the
+ * project's scenes and two synthetic scenes of about 100k triangles.  The
+ * rays are a path tracer's: camera rays, diffuse bounces from their hits,
+ * and visibility rays between hit points. */
+#define _POSIX_C_SOURCE 200809L
+#include <dirent.h>
+#include <math.h>
+#include <omp.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "geom/shapes.h"
+#include "render/render_scene.h"
+#include "scene/scene.h"
+
+enum {
+    CAMERA_RAYS = 1 << 16,
+    BRUTE_MAX_PARTS = 2000 /* brute force only where it finishes quickly */
+};
+/* Each figure is the best of a few short runs: the machine may be shared. */
+static const double MIN_SECONDS = 0.05;
+enum { RUNS = 3 };
+
+static const struct {
+    accel_kind kind;
+    const char *name;
+} BACKENDS[] = {{ACCEL_BRUTE, "brute"}, {ACCEL_EMBREE, "embree"}, {ACCEL_BVH, "bvh"}};
+
+typedef struct bench_ray {
+    vec3f o, d;
+    float dist;  /* visibility rays: the target's distance */
+    int bg;      /* and whether it is in the background */
+} bench_ray;
+
+typedef struct ray_set {
+    bench_ray *nearest, *any;
+    int n_nearest, n_any;
+} ray_set;
+
+static float rnd(uint32_t *s)
+{
+    *s ^= *s << 13;
+    *s ^= *s >> 17;
+    *s ^= *s << 5;
+    return (float)(*s >> 8) * (1.0f / 16777216.0f);
+}
+
+/* Cosine-weighted about n, as a diffuse bounce samples. */
+static vec3f bounce(vec3f n, uint32_t *s)
+{
+    vec3f t, b;
+    f3_basis(n, &t, &b);
+    float r = sqrtf(rnd(s)), phi = 6.2831853f * rnd(s);
+    float z = sqrtf(fmaxf(0.0f, 1.0f - r * r));
+    return f3_add(f3_scale(n, z), f3_add(f3_scale(t, r * cosf(phi)), f3_scale(b, r * sinf(phi))));
+}
+
+typedef struct surface_point {
+    vec3f x, n; /* n faces the side the ray came from */
+    int bg;
+} surface_point;
+
+static int record_hit(const rscene *rs, vec3f o, vec3f d, surface_point *out)
+{
+    hit h = accel_intersect(rs, o, d);
+    if (h.part < 0)
+        return 0;
+    const rs_part *p = &rs->parts[h.part];
+    out->x = f3_madd(o, d, h.t);
+    out->n = shape_normal(p, out->x);
+    if (f3_dot(out->n, d) > 0.0f)
+        out->n = f3_neg(out->n);
+    out->bg = p->background;
+    return 1;
+}
+
+static void make_rays(const rscene *rs, const zt_scene *scene, ray_set *set)
+{
+    uint32_t seed = 2024;
+    zt_camera c = zt_scene_get_camera(scene);
+    vec3f eye = f3((float)c.viewpoint[0], (float)c.viewpoint[1], (float)c.viewpoint[2]);
+    set->nearest = malloc(2 * CAMERA_RAYS * sizeof *set->nearest);
+    set->any = malloc(2 * CAMERA_RAYS * sizeof *set->any);
+    surface_point *pts = malloc(2 * CAMERA_RAYS * sizeof *pts);
+    if (!set->nearest || !set->any || !pts) {
+        fprintf(stderr, "out of memory\n");
+        exit(1);
+    }
+    int n = 0, hits = 0;
+    for (int i = 0; i < CAMERA_RAYS; i++) {
+        float u = rnd(&seed), v = rnd(&seed), p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = (float)(c.screen[0][k] + u * (c.screen[1][k] - c.screen[0][k]) +
+                           v * (c.screen[2][k] - c.screen[0][k]));
+        bench_ray *r = &set->nearest[n++];
+        r->o = f3(p[0], p[1], p[2]);
+        r->d = f3_normalize(f3_sub(r->o, eye));
+        hits += record_hit(rs, r->o, r->d, &pts[hits]);
+    }
+    int first_bounce = hits;
+    for (int i = 0; i < first_bounce; i++) {
+        bench_ray *r = &set->nearest[n++];
+        r->d = bounce(pts[i].n, &seed);
+        r->o = ray_offset(pts[i].x, pts[i].n);
+        hits += record_hit(rs, r->o, r->d, &pts[hits]);
+    }
+    set->n_nearest = n;
+    /* Visibility between random pairs of hit points, stopping just short
+     * of the target as a shadow ray does. */
+    set->n_any = 0;
+    for (int i = 0; i < hits && hits > 1; i++) {
+        const surface_point *a = &pts[i], *b = &pts[(int)(rnd(&seed) * (float)hits)];
+        vec3f to = f3_sub(b->x, a->x);
+        float len = f3_length(to);
+        if (len <= 0.0f)
+            continue;
+        bench_ray *r = &set->any[set->n_any++];
+        r->d = f3_scale(to, 1.0f / len);
+        r->o = ray_offset(a->x, f3_dot(r->d, a->n) >= 0.0f ? a->n : f3_neg(a->n));
+        r->dist = 0.9999f * len;
+        r->bg = b->bg;
+    }
+    free(pts);
+}
+
+/* Million rays per second over at least MIN_SECONDS, best of RUNS. */
+static double throughput(const rscene *rs, const ray_set *set, int any, int threads)
+{
+    const bench_ray *rays = any ? set->any : set->nearest;
+    int n = any ? set->n_any : set->n_nearest;
+    if (n == 0)
+        return 0.0;
+    double best = 0.0;
+    long sink = 0;
+    for (int run = 0; run < RUNS; run++) {
+        long passes = 0;
+        double t0 = omp_get_wtime(), t;
+        do {
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 512) reduction(+ : sink)
+            for (int i = 0; i < n; i++)
+                sink += any ? accel_occluded(rs, rays[i].o, rays[i].d, rays[i].dist,
+                                             rays[i].bg)
+                            : accel_intersect(rs, rays[i].o, rays[i].d).part;
+            passes++;
+            t = omp_get_wtime() - t0;
+        } while (t < MIN_SECONDS);
+        best = fmax(best, (double)passes * n / t / 1e6);
+    }
+    if (sink == 42) /* keeps the work from being optimised away */
+        fputc(' ', stderr);
+    return best;
+}
+
+static void bench_scene(const char *name, const zt_scene *scene)
+{
+    rscene rs;
+    zt_error err = {0};
+    if (rscene_build(&rs, scene, NULL, 0, ACCEL_BVH, &err) != ZT_OK) {
+        fprintf(stderr, "%s: %s\n", name, err.message);
+        return;
+    }
+    ray_set set;
+    make_rays(&rs, scene, &set);
+    int prims = rs.part_count - rs.planes[0].count - rs.planes[1].count;
+    int all = omp_get_max_threads();
+    for (size_t k = 0; k < sizeof BACKENDS / sizeof BACKENDS[0]; k++) {
+        if (BACKENDS[k].kind == ACCEL_BRUTE && rs.part_count > BRUTE_MAX_PARTS)
+            continue;
+        accel_free(rs.accel);
+        rs.accel = NULL;
+        double t0 = omp_get_wtime();
+        if (accel_build(&rs, BACKENDS[k].kind, &err) != ZT_OK) {
+            fprintf(stderr, "%s, %s: %s\n", name, BACKENDS[k].name, err.message);
+            continue;
+        }
+        double build_ms = 1e3 * (omp_get_wtime() - t0);
+        printf("%-16s %7d %6d %-7s %9.2f %8.2f %8.2f %8.2f %8.2f\n", name, prims,
+               set.n_nearest + set.n_any, BACKENDS[k].name, build_ms,
+               throughput(&rs, &set, 0, 1), throughput(&rs, &set, 0, all),
+               throughput(&rs, &set, 1, 1), throughput(&rs, &set, 1, all));
+        fflush(stdout);
+    }
+    free(set.nearest);
+    free(set.any);
+    rscene_free(&rs);
+}
+
+/* ---- synthetic scenes: a room of background planes around a mesh ---- */
+
+static void add_object(zt_scene *s, int background, int culled)
+{
+    object o;
+    memset(&o, 0, sizeof o);
+    o.background = background;
+    o.backculled = culled;
+    o.mat = material_default();
+    scene_add_object(s, &o);
+}
+
+static void add_triangle(zt_scene *s, vec3 a, vec3 b, vec3 c)
+{
+    part p;
+    memset(&p, 0, sizeof p);
+    p.shape = SHAPE_TRIANGLE;
+    p.p[0] = a;
+    p.p[1] = b;
+    p.p[2] = c;
+    scene_add_part(s, &p);
+}
+
+static zt_scene *room(void)
+{
+    zt_scene *s = scene_create();
+    if (!s)
+        exit(1);
+    add_object(s, 1, 1);
+    for (int a = 0; a < 6; a++) {
+        part p;
+        memset(&p, 0, sizeof p);
+        p.shape = SHAPE_PLANE;
+        double n[3] = {0, 0, 0};
+        n[a / 2] = a % 2 ? -1 : 1;
+        p.normal = v3(n[0], n[1], n[2]);
+        p.offset = a == 5 ? -22 : -10; /* the wall behind the camera at z = 22 */
+        scene_add_part(s, &p);
+    }
+    zt_camera c = {{0, 0, 20}, {{-1, 1, 19}, {1, 1, 19}, {-1, -1, 19}, {1, -1, 19}}, 512, 512};
+    zt_scene_set_camera(s, &c);
+    return s;
+}
+
+/* A bumpy sphere of 2 * nu * (nv - 1) triangles. */
+static vec3 bumpy(int i, int j, int nu, int nv)
+{
+    double th = 3.14159265358979 * j / nv, ph = 6.28318530717959 * i / nu;
+    double r = 7.0 * (1.0 + 0.08 * sin(7 * th) * sin(9 * ph));
+    return v3(r * sin(th) * cos(ph), r * cos(th), r * sin(th) * sin(ph));
+}
+
+static zt_scene *mesh_scene(void)
+{
+    zt_scene *s = room();
+    add_object(s, 0, 1);
+    const int nu = 320, nv = 157;
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            vec3 a = bumpy(i, j, nu, nv), b = bumpy(i + 1, j, nu, nv);
+            vec3 c = bumpy(i, j + 1, nu, nv), d = bumpy(i + 1, j + 1, nu, nv);
+            if (j > 0)
+                add_triangle(s, a, b, c);
+            if (j < nv - 1)
+                add_triangle(s, b, d, c);
+        }
+    return s;
+}
+
+static zt_scene *soup_scene(void)
+{
+    zt_scene *s = room();
+    add_object(s, 0, 0);
+    uint32_t seed = 7;
+    for (int i = 0; i < 100000; i++) {
+        vec3 a = v3(16 * rnd(&seed) - 8, 16 * rnd(&seed) - 8, 16 * rnd(&seed) - 8);
+        vec3 e[2];
+        for (int k = 0; k < 2; k++)
+            e[k] = v3(0.6 * rnd(&seed) - 0.3, 0.6 * rnd(&seed) - 0.3, 0.6 * rnd(&seed) - 0.3);
+        add_triangle(s, a, v3_add(a, e[0]), v3_add(a, e[1]));
+    }
+    return s;
+}
+
+/* The project's scenes folder: argv[1], or found from this file's path. */
+static void scenes_dir(int argc, char **argv, char *out, size_t size)
+{
+    if (argc > 1) {
+        snprintf(out, size, "%s", argv[1]);
+        return;
+    }
+    snprintf(out, size, "%s", __FILE__);
+    char *slash = strrchr(out, '/');
+    if (slash)
+        snprintf(slash, size - (size_t)(slash - out), "/../scenes");
+    else
+        snprintf(out, size, "scenes");
+}
+
+int main(int argc, char **argv)
+{
+    char dir[1024];
+    scenes_dir(argc, argv, dir, sizeof dir);
+    printf("Mrays/s on 1 and %d threads; build in ms; planes are not counted as "
+           "primitives\n\n", omp_get_max_threads());
+    printf("%-16s %7s %6s %-7s %9s %8s %8s %8s %8s\n", "scene", "prims", "rays",
+           "backend", "build", "near 1T", "near NT", "any 1T", "any NT");
+    struct dirent **names;
+    int count = scandir(dir, &names, NULL, alphasort);
+    for (int i = 0; i < count; i++) {
+        const char *f = names[i]->d_name;
+        size_t len = strlen(f);
+        if (len > 5 && strcmp(f + len - 5, ".json") == 0) {
+            char path[2048];
+            snprintf(path, sizeof path, "%s/%s", dir, f);
+            zt_scene *s = NULL;
+            zt_error err = {0};
+            if (zt_scene_load_file(path, &s, &err) == ZT_OK)
+                bench_scene(f, s);
+            else
+                fprintf(stderr, "%s\n", err.message);
+            zt_scene_release(s);
+        }
+        free(names[i]);
+    }
+    if (count >= 0)
+        free(names);
+    else
+        fprintf(stderr, "%s: cannot list the scenes\n", dir);
+    zt_scene *s = mesh_scene();
+    bench_scene("bumpy sphere", s);
+    zt_scene_release(s);
+    s = soup_scene();
+    bench_scene("random soup", s);
+    zt_scene_release(s);
+    return 0;
+}
