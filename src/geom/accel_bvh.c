@@ -190,6 +190,13 @@ typedef struct box {
     float lo[3], hi[3];
 } box;
 
+/* A primitive during the build: its padded bounds and its part.  The
+ * references are partitioned in place, so every pass reads memory in order. */
+typedef struct prim_ref {
+    box b;
+    int part;
+} prim_ref;
+
 static box box_empty(void)
 {
     box b = {{FLT_MAX, FLT_MAX, FLT_MAX}, {-FLT_MAX, -FLT_MAX, -FLT_MAX}};
@@ -204,10 +211,12 @@ static void box_grow(box *b, const box *x)
     }
 }
 
-static void box_add_point(box *b, vec3f p)
+static void box_add_point(box *b, const float p[3])
 {
-    box x = {{p.x, p.y, p.z}, {p.x, p.y, p.z}};
-    box_grow(b, &x);
+    for (int a = 0; a < 3; a++) {
+        b->lo[a] = fmin2(b->lo[a], p[a]);
+        b->hi[a] = fmax2(b->hi[a], p[a]);
+    }
 }
 
 static float half_area(const box *b)
@@ -217,20 +226,26 @@ static float half_area(const box *b)
     return x < 0.0f ? 0.0f : x * y + y * z + z * x;
 }
 
+static float centre(const prim_ref *r, int axis)
+{
+    return 0.5f * (r->b.lo[axis] + r->b.hi[axis]);
+}
+
 /* The part's bounds, padded by a few units in the last place: the shape
  * tests round, and may accept a hit a hair outside the exact bounds. */
 static box part_box(const rs_part *p)
 {
     box b = box_empty();
-    if (p->shape == SHAPE_TRIANGLE) {
-        box_add_point(&b, p->p0);
-        box_add_point(&b, f3_add(p->p0, p->e1));
-        box_add_point(&b, f3_add(p->p0, p->e2));
-    } else {
+    vec3f v[3] = {p->p0, f3_add(p->p0, p->e1), f3_add(p->p0, p->e2)};
+    int corners = 3;
+    if (p->shape == SHAPE_SPHERE) {
         float r = fabsf(p->radius);
-        box_add_point(&b, f3_sub(p->p0, f3_splat(r)));
-        box_add_point(&b, f3_add(p->p0, f3_splat(r)));
+        v[0] = f3_sub(p->p0, f3_splat(r));
+        v[1] = f3_add(p->p0, f3_splat(r));
+        corners = 2;
     }
+    for (int k = 0; k < corners; k++)
+        box_add_point(&b, (const float[3]){v[k].x, v[k].y, v[k].z});
     float m = 0.0f;
     for (int a = 0; a < 3; a++)
         m = fmax2(m, fmax2(fmax2(fabsf(b.lo[a]), fabsf(b.hi[a])),
@@ -244,55 +259,70 @@ static box part_box(const rs_part *p)
 }
 
 typedef struct builder {
-    const box *bounds;  /* per primitive, in input order */
-    float (*cent)[3];   /* bounds centres */
-    int *order;         /* input indices, permuted into tree order */
+    prim_ref *refs;
     bvh_node *nodes;
     int node_count;
 } builder;
 
-static int bin_of(float c, float lo, float scale)
+/* Bins of the centroid bounds cb along one axis. */
+typedef struct binning {
+    float lo, scale;
+} binning;
+
+static binning binning_of(const box *cb, int axis)
 {
-    float f = (c - lo) * scale;
+    binning g = {cb->lo[axis], (float)BINS / (cb->hi[axis] - cb->lo[axis])};
+    return g;
+}
+
+static int bin_of(binning g, float c)
+{
+    float f = (c - g.lo) * g.scale;
     if (!(f > 0.0f))
-        return 0;
+        return 0; /* also NaN, from a zero-width axis */
     return f < (float)BINS ? (int)f : BINS - 1;
 }
 
-/* The best binned SAH split of order[begin, end), as axis and first bin of
- * the right side; its cost in half-area units, or FLT_MAX if none. */
+/* The best binned SAH split of refs[begin, end), as axis and first bin of
+ * the right side; its cost in half-area units, or FLT_MAX if none.  All
+ * three axes are binned in one pass. */
 static float sah_best(const builder *b, int begin, int end, const box *cb,
                       int *best_axis, int *best_bin)
 {
+    int count[3][BINS] = {{0}};
+    box bins[3][BINS];
+    binning g[3];
+    for (int a = 0; a < 3; a++) {
+        g[a] = binning_of(cb, a);
+        for (int k = 0; k < BINS; k++)
+            bins[a][k] = box_empty();
+    }
+    for (int i = begin; i < end; i++) {
+        const prim_ref *r = &b->refs[i];
+        for (int a = 0; a < 3; a++) {
+            int k = bin_of(g[a], centre(r, a));
+            count[a][k]++;
+            box_grow(&bins[a][k], &r->b);
+        }
+    }
     float best = FLT_MAX;
     for (int a = 0; a < 3; a++) {
-        float ext = cb->hi[a] - cb->lo[a];
-        if (!(ext > 0.0f))
+        if (!(cb->hi[a] > cb->lo[a]))
             continue;
-        float scale = (float)BINS / ext;
-        int count[BINS] = {0};
-        box bins[BINS];
-        for (int k = 0; k < BINS; k++)
-            bins[k] = box_empty();
-        for (int i = begin; i < end; i++) {
-            int k = bin_of(b->cent[b->order[i]][a], cb->lo[a], scale);
-            count[k]++;
-            box_grow(&bins[k], &b->bounds[b->order[i]]);
-        }
         /* right_cost[k]: area times count of bins k.. */
         float right_cost[BINS];
         box acc = box_empty();
         int n = 0;
         for (int k = BINS - 1; k > 0; k--) {
-            box_grow(&acc, &bins[k]);
-            n += count[k];
+            box_grow(&acc, &bins[a][k]);
+            n += count[a][k];
             right_cost[k] = n ? half_area(&acc) * (float)n : -1.0f;
         }
         acc = box_empty();
         n = 0;
         for (int k = 1; k < BINS; k++) {
-            box_grow(&acc, &bins[k - 1]);
-            n += count[k - 1];
+            box_grow(&acc, &bins[a][k - 1]);
+            n += count[a][k - 1];
             if (n == 0 || right_cost[k] < 0.0f)
                 continue;
             float cost = half_area(&acc) * (float)n + right_cost[k];
@@ -306,27 +336,26 @@ static float sah_best(const builder *b, int begin, int end, const box *cb,
     return best;
 }
 
-static float centre(const builder *b, int i, int axis)
+static void swap_refs(prim_ref *a, prim_ref *b)
 {
-    return b->cent[b->order[i]][axis];
+    prim_ref t = *a;
+    *a = *b;
+    *b = t;
 }
 
-/* Reorders order[lo, hi) so that order[nth] has the nth centre on axis. */
-static void select_nth(builder *b, int lo, int hi, int nth, int axis)
+/* Reorders refs[lo, hi) so that refs[nth] has the nth centre on axis. */
+static void select_nth(prim_ref *refs, int lo, int hi, int nth, int axis)
 {
     while (hi - lo > 1) {
-        float pivot = centre(b, lo + (hi - lo) / 2, axis);
+        float pivot = centre(&refs[lo + (hi - lo) / 2], axis);
         int i = lo, j = hi - 1;
         while (i <= j) {
-            while (centre(b, i, axis) < pivot)
+            while (centre(&refs[i], axis) < pivot)
                 i++;
-            while (centre(b, j, axis) > pivot)
+            while (centre(&refs[j], axis) > pivot)
                 j--;
-            if (i <= j) {
-                int t = b->order[i];
-                b->order[i++] = b->order[j];
-                b->order[j--] = t;
-            }
+            if (i <= j)
+                swap_refs(&refs[i++], &refs[j--]);
         }
         if (nth <= j)
             hi = j + 1;
@@ -337,36 +366,29 @@ static void select_nth(builder *b, int lo, int hi, int nth, int axis)
     }
 }
 
-/* Where to split order[begin, end), or 0 for a leaf. */
+/* Where to split refs[begin, end) (node bounds nb, centroid bounds cb), or
+ * 0 for a leaf. */
 static int choose_split(builder *b, int begin, int end, const box *nb,
-                        int depth)
+                        const box *cb, int depth)
 {
     int n = end - begin;
     if (n <= 1)
         return 0;
-    box cb = box_empty();
-    for (int i = begin; i < end; i++) {
-        const float *c = b->cent[b->order[i]];
-        box_add_point(&cb, f3(c[0], c[1], c[2]));
-    }
     int axis = 0, bin = 0;
     if (depth < SAH_DEPTH) {
-        float cost = sah_best(b, begin, end, &cb, &axis, &bin);
+        float cost = sah_best(b, begin, end, cb, &axis, &bin);
         /* Traversal and a primitive test are taken to cost the same. */
         float leaf = half_area(nb) * (float)n;
         if (n <= LEAF_MAX && leaf <= cost + half_area(nb))
             return 0;
         if (cost < FLT_MAX) {
-            float scale = (float)BINS / (cb.hi[axis] - cb.lo[axis]);
+            binning g = binning_of(cb, axis);
             int i = begin, j = end;
             while (i < j) {
-                if (bin_of(centre(b, i, axis), cb.lo[axis], scale) < bin) {
+                if (bin_of(g, centre(&b->refs[i], axis)) < bin)
                     i++;
-                } else {
-                    int t = b->order[i];
-                    b->order[i] = b->order[--j];
-                    b->order[j] = t;
-                }
+                else
+                    swap_refs(&b->refs[i], &b->refs[--j]);
             }
             return i;
         }
@@ -375,22 +397,25 @@ static int choose_split(builder *b, int begin, int end, const box *nb,
     }
     /* No useful SAH split (or too deep): halve by count on the widest axis. */
     for (int a = 1; a < 3; a++)
-        if (cb.hi[a] - cb.lo[a] > cb.hi[axis] - cb.lo[axis])
+        if (cb->hi[a] - cb->lo[a] > cb->hi[axis] - cb->lo[axis])
             axis = a;
     int mid = begin + n / 2;
-    select_nth(b, begin, end, mid, axis);
+    select_nth(b->refs, begin, end, mid, axis);
     return mid;
 }
 
-/* Builds the subtree of order[begin, end) at the next free node, depth
+/* Builds the subtree of refs[begin, end) at the next free node, depth
  * first, and returns its index. */
 static int build_node(builder *b, int begin, int end, int depth)
 {
     int ni = b->node_count++;
-    box nb = box_empty();
-    for (int i = begin; i < end; i++)
-        box_grow(&nb, &b->bounds[b->order[i]]);
-    int mid = choose_split(b, begin, end, &nb, depth);
+    box nb = box_empty(), cb = box_empty();
+    for (int i = begin; i < end; i++) {
+        const prim_ref *r = &b->refs[i];
+        box_grow(&nb, &r->b);
+        box_add_point(&cb, (const float[3]){centre(r, 0), centre(r, 1), centre(r, 2)});
+    }
+    int mid = choose_split(b, begin, end, &nb, &cb, depth);
     bvh_node *n = &b->nodes[ni];
     for (int a = 0; a < 3; a++) {
         n->bound[0][a] = nb.lo[a];
@@ -421,44 +446,35 @@ static int build_tree(bvh_tree *tr, const rscene *rs, int layer)
         count += in_layer(&rs->parts[i], layer);
     if (count == 0)
         return 1;
-    int *ids = malloc((size_t)count * sizeof *ids);
-    box *bounds = malloc((size_t)count * sizeof *bounds);
-    float (*cent)[3] = malloc((size_t)count * sizeof *cent);
-    int *order = malloc((size_t)count * sizeof *order);
+    prim_ref *refs = malloc((size_t)count * sizeof *refs);
     tr->nodes = malloc((size_t)(2 * count - 1) * sizeof *tr->nodes);
     tr->prims = malloc((size_t)count * sizeof *tr->prims);
-    int ok = ids && bounds && cent && order && tr->nodes && tr->prims;
-    if (ok) {
-        int k = 0;
-        for (int i = 0; i < rs->part_count; i++)
-            if (in_layer(&rs->parts[i], layer))
-                ids[k++] = i;
-        for (int i = 0; i < count; i++) {
-            bounds[i] = part_box(&rs->parts[ids[i]]);
-            for (int a = 0; a < 3; a++)
-                cent[i][a] = 0.5f * (bounds[i].lo[a] + bounds[i].hi[a]);
-            order[i] = i;
-        }
-        builder b = {bounds, cent, order, tr->nodes, 0};
-        build_node(&b, 0, count, 0);
-        tr->node_count = b.node_count;
-        for (int i = 0; i < count; i++) {
-            const rs_part *p = &rs->parts[ids[order[i]]];
-            bvh_prim *q = &tr->prims[i];
-            q->p0 = p->p0;
-            q->e1 = p->e1;
-            q->e2 = p->e2;
-            q->radius = p->radius;
-            q->part = ids[order[i]];
-            q->shape = p->shape;
-            q->culled = p->culled;
-        }
+    if (!refs || !tr->nodes || !tr->prims) {
+        free(refs);
+        return 0;
     }
-    free(ids);
-    free(bounds);
-    free(cent);
-    free(order);
-    return ok;
+    int k = 0;
+    for (int i = 0; i < rs->part_count; i++)
+        if (in_layer(&rs->parts[i], layer)) {
+            refs[k].b = part_box(&rs->parts[i]);
+            refs[k++].part = i;
+        }
+    builder b = {refs, tr->nodes, 0};
+    build_node(&b, 0, count, 0);
+    tr->node_count = b.node_count;
+    for (int i = 0; i < count; i++) {
+        const rs_part *p = &rs->parts[refs[i].part];
+        bvh_prim *q = &tr->prims[i];
+        q->p0 = p->p0;
+        q->e1 = p->e1;
+        q->e2 = p->e2;
+        q->radius = p->radius;
+        q->part = refs[i].part;
+        q->shape = p->shape;
+        q->culled = p->culled;
+    }
+    free(refs);
+    return 1;
 }
 
 zt_status accel_build_bvh(rscene *rs, zt_error *err)

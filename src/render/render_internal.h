@@ -48,8 +48,9 @@ zt_status zone_accumulate(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
                           zt_error *err);
 void zone_release(zt_renderer *r);
 
-/* The acceleration structure renderers use; ZT_ACCEL=brute in the
- * environment selects the brute-force oracle (for tests and benchmarks). */
+/* The acceleration structure renderers use: Embree unless ZT_ACCEL in the
+ * environment says "bvh" (our own) or "brute" (the oracle), for tests and
+ * benchmarks. */
 int render_accel_kind(void);
 
 #endif
