@@ -11,6 +11,7 @@
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
 #include "util/error.h"
+#include "zone/transfer.h"
 #include "zone/zone_internal.h"
 
 /* Bounds of the finite geometry and the camera, where planes need maps. */
@@ -43,6 +44,41 @@ static void scene_bounds(const zt_scene *sc, vec3 *lo, vec3 *hi)
         *lo = v3(fmin(lo->x, q.x), fmin(lo->y, q.y), fmin(lo->z, q.z));
         *hi = v3(fmax(hi->x, q.x), fmax(hi->y, q.y), fmax(hi->z, q.z));
     }
+    /* Rooms made of planes reach past the objects in them: add the corners
+     * where three planes meet, unless they lie absurdly far away. */
+    vec3 centre = v3_scale(v3_add(*lo, *hi), 0.5);
+    double reach = 4.0 * v3_length(v3_sub(*hi, *lo)) + 1e-9;
+    vec3 add_lo = *lo, add_hi = *hi;
+    for (int a = 0; a < sc->part_count; a++) {
+        const part *pa = &sc->parts[a];
+        if (pa->shape != SHAPE_PLANE)
+            continue;
+        for (int b = a + 1; b < sc->part_count; b++) {
+            const part *pb = &sc->parts[b];
+            if (pb->shape != SHAPE_PLANE)
+                continue;
+            for (int k = b + 1; k < sc->part_count; k++) {
+                const part *pc = &sc->parts[k];
+                if (pc->shape != SHAPE_PLANE)
+                    continue;
+                vec3 bc = v3_cross(pb->normal, pc->normal);
+                double det = v3_dot(pa->normal, bc);
+                if (fabs(det) < 1e-9)
+                    continue;
+                /* Cramer's rule for the point on all three planes. */
+                vec3 q = v3_scale(v3_add(v3_add(v3_scale(bc, pa->offset),
+                                                v3_scale(v3_cross(pc->normal, pa->normal), pb->offset)),
+                                         v3_scale(v3_cross(pa->normal, pb->normal), pc->offset)),
+                                  1.0 / det);
+                if (v3_length(v3_sub(q, centre)) > reach)
+                    continue;
+                add_lo = v3(fmin(add_lo.x, q.x), fmin(add_lo.y, q.y), fmin(add_lo.z, q.z));
+                add_hi = v3(fmax(add_hi.x, q.x), fmax(add_hi.y, q.y), fmax(add_hi.z, q.z));
+            }
+        }
+    }
+    *lo = add_lo;
+    *hi = add_hi;
 }
 
 static int clampi(double v, int lo, int hi)
@@ -146,9 +182,15 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
         }
         if (f3_is_black(rs->sky))
             return e;
+    } else {
+        /* Flat diffuse surfaces by exact transfer over their maps. */
+        e = transfer_irradiance(t, part_index, x, n, level, f->q.theta);
+        if (!f->need_gather)
+            return e;
     }
-    /* Gather: E = pi * mean of the radiance over cosine-distributed
-     * directions (for level 0 only the sky's share is gathered). */
+    /* The rest by gathering: E = pi * mean radiance over cosine-distributed
+     * directions, counting only what the transfer left out (the sky at
+     * level 0; specular surfaces and spheres above). */
     vec3 tt, bb;
     frame(n, &tt, &bb);
     vec3f o = ray_offset(to_f(x), to_f(n));
@@ -164,7 +206,8 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
             t->rays++;
             l = h.part < 0 ? v3(rs->sky.x, rs->sky.y, rs->sky.z) : v3(0, 0, 0);
         } else {
-            l = zone_radiance(t, o, to_f(v3_normalize(d)), level, level, 0, NULL, 0);
+            l = zone_radiance(t, o, to_f(v3_normalize(d)), level, level, ZR_SKIP_FLAT_DIFFUSE,
+                              NULL, 0);
         }
         sum = v3_add(sum, l);
     }
@@ -240,6 +283,17 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
     vec3 *dirs = gather_directions(f->q.gather);
     if (!dirs)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    f->dirs = dirs;
+    /* Gathers are needed for what transfer does not cover: light arriving
+     * from specular surfaces or diffuse spheres. */
+    f->need_gather = 0;
+    for (int i = 0; i < sc->part_count; i++) {
+        const object *o = &sc->objects[sc->parts[i].object];
+        if (o->is_light)
+            continue;
+        if (o->mat.weight[LOBE_DIFFUSE] < 1.0 || sc->parts[i].shape == SHAPE_SPHERE)
+            f->need_gather = 1;
+    }
     for (int i = 0; i < sc->part_count; i++) {
         part_map *m = &f->maps[i];
         if (!m->texels)
@@ -284,14 +338,12 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                 }
                 rays += t.rays;
             }
-            if (!map_build_mips(m, level)) {
-                free(dirs);
+            if (!map_build_mips(m, level) || !transfer_build_tables(m, level)) {
                 return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
             }
         }
     }
     f->rays += rays;
-    free(dirs);
     return ZT_OK;
 }
 
@@ -301,6 +353,7 @@ void forest_free(zone_forest *f)
         for (int i = 0; i < f->map_count; i++)
             map_free(&f->maps[i]);
     free(f->maps);
+    free(f->dirs);
     free(f->zones);
     free(f->occluders);
 }

@@ -177,4 +177,5 @@ void map_free(part_map *m)
         free(m->mip[k]);
     for (int k = 0; k < MAP_MIPS; k++)
         free(m->weight[k]);
+    free(m->sat);
 }

@@ -34,6 +34,9 @@ typedef struct part_map {
      * (0 for texel centres inside closed objects or outside the room); the
      * same for every level.  weight[0] is the grid's, the rest the copies'. */
     float *weight[MAP_MIPS];
+    /* Summed-area tables per level and side: [level][side][(nv+1)*(nu+1)]
+     * of weight*rgb (3 doubles) and weight, built by transfer.c. */
+    double *sat;
 } part_map;
 
 /* Texel centre (i, j) of the layout as a point and the surface normal. */

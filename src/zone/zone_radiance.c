@@ -62,7 +62,8 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
     vec3 x = to_d(xf), n = to_d(nf), color = to_d(m->color);
     vec3 out = v3(0, 0, 0);
 
-    if (m->weight[LOBE_DIFFUSE] > 0.0f) {
+    int skip_diffuse = (flags & ZR_SKIP_FLAT_DIFFUSE) && p->shape != SHAPE_SPHERE;
+    if (m->weight[LOBE_DIFFUSE] > 0.0f && !skip_diffuse) {
         vec3 e = v3(0, 0, 0);
         const part_map *pm = &t->f->maps[h.part];
         for (int l = lo > 1 ? lo : 1; l <= hi; l++) {
