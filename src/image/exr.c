@@ -88,7 +88,7 @@ static int64_t write_at(exr_const_context_t ctxt, void *user, const void *buffer
 static zt_status exr_failure(zt_error *err, zt_status status, const char *name,
                              const exr_io *io, exr_result_t rv)
 {
-    return zt_fail(err, status, "%s: %s", name,
+    return zt_fail(err, status, "%s: %s%s", name, status == ZT_ERR_PARSE ? "bad EXR: " : "",
                    io->message[0] ? io->message : exr_get_error_code_as_string(rv));
 }
 
@@ -103,6 +103,8 @@ static exr_result_t write_chunks(exr_context_t ctxt, int part, const zt_image *i
 {
     int32_t lines = 0;
     exr_result_t rv = exr_get_scanlines_per_chunk(ctxt, part, &lines);
+    if (rv == EXR_ERR_SUCCESS && lines < 1)
+        rv = EXR_ERR_INVALID_ARGUMENT;
     exr_encode_pipeline_t encoder = EXR_ENCODE_PIPELINE_INITIALIZER;
     int started = 0;
     size_t row_floats = (size_t)image->width * 3;

@@ -1,7 +1,7 @@
 /* PNG through libpng.  We write 8-bit RGB, already tonemapped, tagged with
  * how it was encoded: an sRGB chunk for the sRGB curve, gAMA 1/gamma for a
- * power curve.  Reading takes any non-interlaced or interlaced PNG of 1 to
- * 16 bits (grey, palette, RGB, with or without alpha; alpha is dropped) and
+ * power curve.  Reading takes any PNG, interlaced or not, of 1 to 16 bits
+ * (grey, palette, RGB, with or without alpha; alpha is dropped) and
  * linearises it with the inverse of the curve it is tagged with: sRGB when
  * it has an sRGB chunk or no tag at all, x^(1/g) for gAMA g otherwise.  So a
  * PNG we wrote with gamma 1 reads back as k/255 exactly.
@@ -9,6 +9,7 @@
  * its warnings are dropped (the library never prints). */
 #include "image/image_io.h"
 
+#include <errno.h>
 #include <math.h>
 #include <png.h>
 #include <setjmp.h>
@@ -35,6 +36,28 @@ static void on_warning(png_structp png, png_const_charp message)
     (void)message;
 }
 
+/* Our own I/O functions, so that failures say why (libpng's own only say
+ * "Read Error" or "Write Error"). */
+static void write_data(png_structp png, png_bytep data, size_t size)
+{
+    errno = 0;
+    if (fwrite(data, 1, size, png_get_io_ptr(png)) != size)
+        png_error(png, strerror(errno ? errno : EIO));
+}
+
+static void flush_data(png_structp png)
+{
+    (void)png; /* the caller flushes and syncs when it commits the file */
+}
+
+static void read_data(png_structp png, png_bytep data, size_t size)
+{
+    FILE *stream = png_get_io_ptr(png);
+    errno = 0;
+    if (fread(data, 1, size, stream) != size)
+        png_error(png, ferror(stream) ? strerror(errno ? errno : EIO) : "truncated file");
+}
+
 zt_status png_write_rgb8(FILE *stream, const uint8_t *rgb, int width, int height,
                          double gamma, const char *name, zt_error *err)
 {
@@ -50,7 +73,7 @@ zt_status png_write_rgb8(FILE *stream, const uint8_t *rgb, int width, int height
         png_destroy_write_struct(&png, &info);
         return zt_fail(err, ZT_ERR_WRITE, "%s: %s", name, failure.message);
     }
-    png_init_io(png, stream);
+    png_set_write_fn(png, stream, write_data, flush_data);
     png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, 8,
                  PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
@@ -112,7 +135,7 @@ zt_status png_read(FILE *stream, const char *name, zt_image **out, zt_error *err
             fail_status = ZT_ERR_READ;
         return zt_fail(err, fail_status, "%s: bad PNG: %s", name, failure.message);
     }
-    png_init_io(png, stream);
+    png_set_read_fn(png, stream, read_data);
     png_set_user_limits(png, ZT_IMAGE_MAX_SIDE, ZT_IMAGE_MAX_SIDE);
     png_read_info(png, info);
 
@@ -127,8 +150,8 @@ zt_status png_read(FILE *stream, const char *name, zt_image **out, zt_error *err
         png_set_expand_gray_1_2_4_to_8(png);
     if (!(color_type & PNG_COLOR_MASK_COLOR))
         png_set_gray_to_rgb(png);
-    if (color_type & PNG_COLOR_MASK_ALPHA)
-        png_set_strip_alpha(png);
+    /* unconditionally: expanding a palette also turns its tRNS into alpha */
+    png_set_strip_alpha(png);
     png_set_interlace_handling(png);
     png_read_update_info(png, info);
 

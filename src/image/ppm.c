@@ -122,8 +122,9 @@ zt_status ppm_read(FILE *stream, const char *name, zt_image **out, zt_error *err
     size_t need = binary ? samples * (maxval > 255 ? 2 : 1) : 2 * samples - 1;
     long left = stream_bytes_left(stream);
     if (left >= 0 && (unsigned long)left < need)
-        return zt_fail(err, ZT_ERR_PARSE, "%s: truncated PPM (%ld bytes of samples)",
-                       name, left);
+        return zt_fail(err, ZT_ERR_PARSE,
+                       "%s: truncated PPM: at least %zu bytes of samples expected, %ld found",
+                       name, need, left);
 
     zt_image *image = zt_image_create((int)width, (int)height);
     float *lut = malloc(((size_t)maxval + 1) * sizeof *lut);
