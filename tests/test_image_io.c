@@ -73,8 +73,10 @@ static char *join(const char *dir, const char *name)
 {
     static char buf[4][600];
     static int next;
+    char tmp[600];
+    snprintf(tmp, sizeof tmp, "%s/%s", dir, name); /* dir may be one of buf */
     char *b = buf[next++ % 4];
-    snprintf(b, sizeof buf[0], "%s/%s", dir, name);
+    memcpy(b, tmp, sizeof tmp);
     return b;
 }
 
