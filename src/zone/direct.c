@@ -118,6 +118,60 @@ static int sphere_silhouette(vec3 centre, double r, vec3 x, vec3 *c, vec3 *w,
     return 1;
 }
 
+/* Points of the circle where plane (pn . p = po) meets the sphere. */
+static int circle_points(vec3 centre, double r, vec3 pn, double po, int k, vec3 *out)
+{
+    double d = v3_dot(pn, centre) - po;
+    if (fabs(d) >= r)
+        return 0;
+    vec3 c = v3_sub(centre, v3_scale(pn, d)), u, v;
+    double rr = sqrt(r * r - d * d);
+    basis(pn, &u, &v);
+    for (int i = 0; i < k; i++) {
+        double a = 2.0 * 3.14159265358979323846 * i / k;
+        out[i] = v3_add(c, v3_add(v3_scale(u, rr * cos(a)), v3_scale(v, rr * sin(a))));
+    }
+    return k;
+}
+
+/* The shadow of a sphere that crosses the light's plane or the level of
+ * x: the projection of the convex part of the sphere between them, whose
+ * outline comes from the silhouette (where it lies between), the circle on
+ * the light's plane, and the circle at x's level (just inside it). */
+static void sphere_cut(const direct_ctx *c, const light_frame *f, vec3 x, const part *o,
+                       vec3 sc, vec3 sw, double sr, poly2_set *set, poly2 *scratch)
+{
+    enum { K = 24 };
+    vec3 pts[3 * K];
+    int n = 0;
+    double s = f->hx > 0 ? 1.0 : -1.0, hx = fabs(f->hx);
+    poly3 sil;
+    disk_polygon(sc, sw, sr, K < c->sides ? c->sides : K, &sil);
+    for (int i = 0; i < sil.n && n < K; i++) {
+        double h = s * height(f, sil.p[i]);
+        if (h > 0 && h < hx)
+            pts[n++] = sil.p[i];
+    }
+    double po = v3_dot(f->n, f->origin);
+    n += circle_points(o->p[0], o->radius, f->n, po, K, pts + n);
+    n += circle_points(o->p[0], o->radius, f->n, po + s * hx * (1.0 - 1e-3), K, pts + n);
+    if (n < 3)
+        return;
+    double xs[3 * K], ys[3 * K];
+    for (int i = 0; i < n; i++) {
+        double h = height(f, pts[i]);
+        double t = f->hx / (f->hx - h);
+        vec3 q = v3_add(x, v3_scale(v3_sub(pts[i], x), t));
+        vec3 d = v3_sub(q, f->origin);
+        xs[i] = v3_dot(d, f->u);
+        ys[i] = v3_dot(d, f->v);
+    }
+    poly2 hole;
+    poly2_hull(xs, ys, n, &hole);
+    if (hole.n >= 3)
+        poly2_set_subtract(set, &hole, scratch);
+}
+
 /* Cuts the shadow of part `o` (seen from x) out of the light's pieces.
  * Returns 1 when x is wholly enclosed (inside an opaque sphere). */
 static int occlude_with(const direct_ctx *c, const light_frame *f, vec3 x,
@@ -148,6 +202,13 @@ static int occlude_with(const direct_ctx *c, const light_frame *f, vec3 x,
             return !oo->backculled; /* inside: opaque unless culled */
         if (v3_dot(n, v3_sub(o->p[0], x)) <= -o->radius)
             return 0;
+        double hc = height(f, o->p[0]), s = f->hx > 0 ? 1.0 : -1.0;
+        if (!beyond && (s * hc - o->radius <= 0 || s * hc + o->radius >= fabs(f->hx))) {
+            /* The sphere crosses the light's plane or x's level: its shadow
+             * is the projection of the part between them. */
+            sphere_cut(c, f, x, o, sc, sw, sr, set, scratch);
+            return 0;
+        }
         disk_polygon(sc, sw, sr, c->sides, &poly);
         break;
     }

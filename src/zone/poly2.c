@@ -123,3 +123,47 @@ void poly2_set_subtract(poly2_set *set, const poly2 *hole, poly2 *rest)
         }
     }
 }
+
+static double cross3(double ox, double oy, double ax, double ay, double bx, double by)
+{
+    return (ax - ox) * (by - oy) - (ay - oy) * (bx - ox);
+}
+
+void poly2_hull(double *xs, double *ys, int n, poly2 *out)
+{
+    /* Andrew's monotone chain on points sorted by x then y (insertion sort:
+     * the sets here are small). */
+    for (int i = 1; i < n; i++) {
+        double x = xs[i], y = ys[i];
+        int j = i - 1;
+        while (j >= 0 && (xs[j] > x || (xs[j] == x && ys[j] > y))) {
+            xs[j + 1] = xs[j];
+            ys[j + 1] = ys[j];
+            j--;
+        }
+        xs[j + 1] = x;
+        ys[j + 1] = y;
+    }
+    double hx[2 * POLY2_MAX + 2], hy[2 * POLY2_MAX + 2];
+    int k = 0;
+    for (int i = 0; i < n && k < 2 * POLY2_MAX; i++) {
+        while (k >= 2 && cross3(hx[k - 2], hy[k - 2], hx[k - 1], hy[k - 1], xs[i], ys[i]) <= 0)
+            k--;
+        hx[k] = xs[i];
+        hy[k] = ys[i];
+        k++;
+    }
+    for (int i = n - 2, lower = k + 1; i >= 0 && k < 2 * POLY2_MAX; i--) {
+        while (k >= lower && cross3(hx[k - 2], hy[k - 2], hx[k - 1], hy[k - 1], xs[i], ys[i]) <= 0)
+            k--;
+        hx[k] = xs[i];
+        hy[k] = ys[i];
+        k++;
+    }
+    out->n = 0;
+    for (int i = 0; i < k - 1 && out->n < POLY2_MAX; i++) {
+        out->x[out->n] = hx[i];
+        out->y[out->n] = hy[i];
+        out->n++;
+    }
+}

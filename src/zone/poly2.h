@@ -26,6 +26,10 @@ void poly2_clip(poly2 *p, double a, double b, double c);
 void poly2_split(const poly2 *p, double a, double b, double c, poly2 *inside,
                  poly2 *outside);
 
+/* The convex hull of n points (counter-clockwise, at most POLY2_MAX
+ * vertices; xs and ys are reordered). */
+void poly2_hull(double *xs, double *ys, int n, poly2 *out);
+
 /* A list of disjoint convex pieces. */
 typedef struct poly2_set {
     poly2 *piece;
