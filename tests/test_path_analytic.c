@@ -583,7 +583,7 @@ static void sphere_furnace(double r, double le, int spp_level, int spp_depth,
 static void test_integrating_sphere_sphere_light(void **state)
 {
     (void)state;
-    sphere_furnace(0.5, 1.0, 128, 256, 3e-3);   /* s^2 = 0.25: both strategies */
+    sphere_furnace(0.5, 1.0, 256, 256, 3e-3);   /* s^2 = 0.25: both strategies */
     sphere_furnace(0.02, 2500.0, 16, 512, 4e-3); /* a small cone: light sampling */
 }
 

@@ -24,6 +24,21 @@ int cli_render(int argc, char **argv);
 int cli_compare(int argc, char **argv);
 int cli_view(int argc, char **argv);
 
+/* Offline animation (render --motions FILE --frames N --fps F --time T). */
+typedef struct cli_animation {
+    const char *motions; /* motions file, or NULL */
+    int frames;          /* frames to render (default 1) */
+    double fps;          /* frame k is at time + k/fps (default 24) */
+    double time;         /* time of frame 0 in seconds (default 0) */
+    int given;           /* any of the four options was given */
+} cli_animation;
+
+/* Loads the scene and the motions and renders the frames to output (a
+ * name with a %d frame number when frames > 1).  Returns an exit code. */
+int cli_animate(const char *scene_path, const zt_render_options *options,
+                const zt_tonemap *tonemap, const char *output, int width, int height,
+                const cli_animation *anim, int verbose, int quiet);
+
 /* Progress display on stderr: a bar with ETA on a terminal, plain lines
  * otherwise. */
 typedef struct cli_progress {

@@ -43,6 +43,19 @@ static void render_usage(FILE *f)
 "      --strategy S      pixel (default) or zone\n"
 "      --cutoff X        prune zones whose power bound is below X (default 0)\n"
 "      --quality Q       discretisation level, higher is finer (default 2)\n"
+"      --save-forest FILE  write the forest (Phase One: zones, occluders, maps)\n"
+"                        to FILE; it does not depend on the camera\n"
+"      --load-forest FILE  read the forest from FILE instead of building it; FILE\n"
+"                        must be for this scene with the same depth/level,\n"
+"                        cutoff, quality and lights-off\n"
+"\n"
+"Animation (docs/viewer.md):\n"
+"      --motions FILE    move objects as the motions file says; renders the\n"
+"                        scene at --time (default 0)\n"
+"      --frames N        render N frames, frame k at time T + k/F; -o must hold\n"
+"                        a frame number such as frame_%%04d.png\n"
+"      --fps F           frames per second of the animation (default 24)\n"
+"      --time T          time of the first frame in seconds (default 0)\n"
 "\n"
 "Running:\n"
 "      --threads T       threads (default: all cores)\n"
@@ -57,7 +70,8 @@ static void render_usage(FILE *f)
 enum {
     OPT_SIZE = 256, OPT_SPP, OPT_DEPTH, OPT_LEVEL, OPT_SEED, OPT_THREADS,
     OPT_METHOD, OPT_GAMMA, OPT_EXPOSURE, OPT_STRATEGY, OPT_CUTOFF, OPT_QUALITY,
-    OPT_LIGHTS_OFF
+    OPT_LIGHTS_OFF, OPT_MOTIONS, OPT_FRAMES, OPT_FPS, OPT_TIME,
+    OPT_SAVE_FOREST = 400, OPT_LOAD_FOREST
 };
 
 static const struct option long_options[] = {
@@ -75,6 +89,12 @@ static const struct option long_options[] = {
     {"cutoff", required_argument, 0, OPT_CUTOFF},
     {"quality", required_argument, 0, OPT_QUALITY},
     {"lights-off", required_argument, 0, OPT_LIGHTS_OFF},
+    {"save-forest", required_argument, 0, OPT_SAVE_FOREST},
+    {"load-forest", required_argument, 0, OPT_LOAD_FOREST},
+    {"motions", required_argument, 0, OPT_MOTIONS},
+    {"frames", required_argument, 0, OPT_FRAMES},
+    {"fps", required_argument, 0, OPT_FPS},
+    {"time", required_argument, 0, OPT_TIME},
     {"verbose", no_argument, 0, 'v'},
     {"quiet", no_argument, 0, 'q'},
     {"help", no_argument, 0, 'h'},
@@ -112,13 +132,68 @@ static int output_writable(const char *path)
     return 1;
 }
 
+/* The zone tracer's forest figures and phase times (-v). */
+static void print_zone_stats(const zt_render_stats *s, const char *loaded_from)
+{
+    fprintf(stderr, "zones:");
+    for (int l = 0; l < 32; l++)
+        if (s->zones_per_level[l])
+            fprintf(stderr, " level %d: %llu,", l, (unsigned long long)s->zones_per_level[l]);
+    fprintf(stderr, " total %llu; pruned %llu\n", (unsigned long long)s->zones,
+            (unsigned long long)s->zones_pruned);
+    fprintf(stderr, "forest memory: %llu bytes (%.1f MiB: zones, occluder lists and maps)\n",
+            (unsigned long long)s->memory_bytes, s->memory_bytes / 1048576.0);
+    if (s->forest_loaded)
+        fprintf(stderr, "phase one: read from %s in %.3f s; phase two: %.3f s\n",
+                loaded_from, s->phase_one_seconds, s->phase_two_seconds);
+    else
+        fprintf(stderr, "phase one: %.3f s; phase two: %.3f s\n", s->phase_one_seconds,
+                s->phase_two_seconds);
+}
+
+/* zt_render, keeping the renderer long enough to save its forest (written
+ * right after Phase One, so a cancelled render still leaves it). */
+static zt_status render_saving_forest(const zt_scene *scene, const zt_render_options *opt,
+                                      const char *forest_out, zt_image **out,
+                                      zt_render_stats *stats, zt_error *err)
+{
+    memset(stats, 0, sizeof *stats);
+    *out = NULL;
+    double t0 = cli_now();
+    zt_renderer *r = NULL;
+    zt_status st = zt_renderer_create(scene, opt, &r, err);
+    if (st == ZT_OK)
+        st = zt_renderer_save_forest(r, forest_out, err);
+    zt_image *img = NULL;
+    if (st == ZT_OK) {
+        zt_camera cam = zt_scene_get_camera(scene);
+        img = zt_image_create(cam.width, cam.height);
+        if (!img) {
+            st = ZT_ERR_MEMORY;
+            snprintf(err->message, sizeof err->message, "out of memory for the image");
+        }
+    }
+    if (st == ZT_OK)
+        st = zt_renderer_accumulate(r, 0, 1, img, stats, err);
+    zt_renderer_release(r);
+    if (st != ZT_OK) {
+        zt_image_release(img);
+        return st;
+    }
+    stats->seconds = cli_now() - t0;
+    *out = img;
+    return ZT_OK;
+}
+
 int cli_render(int argc, char **argv)
 {
     zt_render_options opt = zt_render_options_default();
     zt_tonemap tm = zt_tonemap_default();
     const char *output = "image.png";
     int width = 0, height = 0, verbose = 0, quiet = 0, depth_given = 0;
+    const char *forest_out = NULL;
     unsigned long long seed = 0;
+    cli_animation anim = {NULL, 1, 24.0, 0.0, 0};
     int c;
     optind = 1;
     opterr = 0;
@@ -153,6 +228,12 @@ int cli_render(int argc, char **argv)
             ok = parse_int_list("--lights-off", optarg, opt.lights_off, ZT_MAX_LIGHTS_OFF,
                                 &opt.lights_off_count);
             break;
+        case OPT_SAVE_FOREST: forest_out = optarg; break;
+        case OPT_LOAD_FOREST: opt.forest_file = optarg; break;
+        case OPT_MOTIONS: anim.motions = optarg; anim.given = 1; break;
+        case OPT_FRAMES: ok = parse_int("--frames", optarg, 1, 1000000, &anim.frames); anim.given = 1; break;
+        case OPT_FPS: ok = parse_double("--fps", optarg, 1e-3, 1e6, &anim.fps); anim.given = 1; break;
+        case OPT_TIME: ok = parse_double("--time", optarg, 0, 1e9, &anim.time); anim.given = 1; break;
         case 'v': verbose = 1; break;
         case 'q': quiet = 1; break;
         case 'h': render_usage(stdout); return EXIT_OK;
@@ -184,9 +265,21 @@ int cli_render(int argc, char **argv)
         }
         opt.depth = opt.level;
     }
+    if ((forest_out || opt.forest_file) && opt.method != ZT_METHOD_ZONE) {
+        cli_error("--save-forest and --load-forest need --method zone");
+        return EXIT_USAGE;
+    }
+    if ((forest_out || opt.forest_file) && anim.given) {
+        cli_error("--save-forest and --load-forest render one image: objects that move "
+                  "(--motions) need a forest per frame");
+        return EXIT_USAGE;
+    }
     int w = output_writable(output);
     if (w <= 0)
         return w < 0 ? EXIT_USAGE : EXIT_UNWRITABLE;
+    if (anim.given)
+        return cli_animate(scene_path, &opt, &tm, output, width, height, &anim,
+                           verbose, quiet);
 
     zt_error err;
     zt_error_clear(&err);
@@ -219,10 +312,16 @@ int cli_render(int argc, char **argv)
         fprintf(stderr, "method %s, depth %d, level %s%d\n",
                 opt.method == ZT_METHOD_PATH ? "path" : "zone", opt.depth,
                 opt.level < 0 ? "all up to " : "", opt.level < 0 ? opt.depth : opt.level);
+        if (opt.method == ZT_METHOD_ZONE)
+            fprintf(stderr, "zone tracer: strategy %s, quality %d, cutoff %g%s%s\n",
+                    opt.strategy == ZT_STRATEGY_ZONE ? "zone" : "pixel", opt.quality,
+                    opt.cutoff, opt.forest_file ? ", forest from " : "",
+                    opt.forest_file ? opt.forest_file : "");
     }
     zt_image *img = NULL;
     zt_render_stats stats;
-    st = zt_render(scene, &opt, &img, &stats, &err);
+    st = forest_out ? render_saving_forest(scene, &opt, forest_out, &img, &stats, &err)
+                    : zt_render(scene, &opt, &img, &stats, &err);
     cli_progress_finish(&prog);
     zt_scene_release(scene);
     if (st != ZT_OK) {
@@ -242,5 +341,7 @@ int cli_render(int argc, char **argv)
                 (unsigned long long)stats.samples, (unsigned long long)stats.rays,
                 rps / 1e6, stats.threads);
     }
+    if (verbose && opt.method == ZT_METHOD_ZONE)
+        print_zone_stats(&stats, opt.forest_file);
     return EXIT_OK;
 }

@@ -5,4 +5,5 @@
 #include "zonetrace/image.h"
 #include "zonetrace/scene.h"
 #include "zonetrace/render.h"
+#include "zonetrace/motion.h"
 #endif
