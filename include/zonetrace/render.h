@@ -50,6 +50,16 @@ typedef struct zt_render_options {
     int quality;        /* zone: discretisation level, higher is finer */
     zt_progress_fn progress;
     void *progress_user;
+    /* Zone tracer: when not NULL, the forest is read from this file (written
+     * by zt_renderer_save_forest) instead of being built: creating the
+     * renderer then costs no Phase One.  The file must have been made for
+     * the same scene (geometry, materials, lights, sky) with the same
+     * effective depth (the level when one is given), cutoff, quality and
+     * lights-off set; the camera may differ.  Otherwise, or when the file
+     * is truncated, corrupt or of another format version, creation fails
+     * with ZT_ERR_PARSE (ZT_ERR_READ when it cannot be read) and a message
+     * naming the file and the reason.  Format: docs/zone-tracer.md. */
+    const char *forest_file;
 } zt_render_options;
 
 /* Defaults: path method, 64 spp, depth 16, all levels, seed 0, all cores. */
@@ -67,6 +77,8 @@ typedef struct zt_render_stats {
     uint64_t zones_pruned;
     uint64_t zones_per_level[32];
     uint64_t memory_bytes;
+    int forest_loaded;     /* zone: the forest came from options.forest_file
+                              (phase_one_seconds is then the time to read it) */
 } zt_render_stats;
 
 /* Renders the scene through its camera into a new linear image (*out, the
@@ -99,6 +111,16 @@ zt_status zt_renderer_accumulate(zt_renderer *renderer, int first_sample,
                                  zt_render_stats *stats, zt_error *err);
 
 void zt_renderer_release(zt_renderer *renderer);
+
+/* Zone tracer: writes the renderer's forest (the zones, their occluder
+ * lists and the irradiance maps: everything Phase One computes; it does not
+ * depend on the camera) to path, replacing the file atomically.  A renderer
+ * created with options.forest_file = path and the same scene and options
+ * then renders the same images bit for bit without Phase One.  Fails with
+ * ZT_ERR_ARGUMENT for a path-tracing renderer, ZT_ERR_WRITE when the file
+ * cannot be written. */
+zt_status zt_renderer_save_forest(const zt_renderer *renderer, const char *path,
+                                  zt_error *err);
 
 /* The library's version string, e.g. "0.1.0". */
 const char *zt_version(void);

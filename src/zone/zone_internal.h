@@ -39,6 +39,8 @@ typedef struct zone_quality {
     double texel;       /* target texel size in scene units */
     int sides;          /* polygon vertices for disks */
     int aa;             /* sub-pixel grid per side */
+    double texel_divisor; /* texel = scene extent / texel_divisor */
+    double theta;       /* transfer: pieces are split above this size/distance */
 } zone_quality;
 
 typedef struct zone_forest {
@@ -52,9 +54,18 @@ typedef struct zone_forest {
     int map_levels;     /* irradiance levels E_0 .. E_{map_levels-1} */
     direct_ctx direct;
     zone_quality q;
+    int need_gather;    /* some light arrives by specular surfaces or spheres */
+    vec3 *dirs;         /* the gather directions (q.gather of them) */
     double phase_one_seconds;
     uint64_t rays;
+    int loaded;         /* read from a forest file (forest_io.c), not built */
+    double build_seconds; /* Phase One time of the build (kept in the file) */
+    int images;         /* images rendered from it so far */
 } zone_forest;
+
+/* The quality settings of --quality q for scene sc (env ZT_ZONE_GATHER and
+ * ZT_ZONE_TEXEL override the gather count and the texel divisor). */
+zone_quality zone_quality_for(const zt_scene *sc, int q);
 
 /* Phase One pieces. */
 zt_status forest_build_tree(zone_forest *f, const zt_renderer *r, zt_error *err);
@@ -71,8 +82,10 @@ typedef struct zone_trace {
 
 enum {
     ZR_EXACT_DIRECT = 1, /* level 1 from the analytic direct term, not maps */
-    ZR_NO_EMISSION = 2   /* lights hit by this very ray count nothing (the
+    ZR_NO_EMISSION = 2,  /* lights hit by this very ray count nothing (the
                             camera's level 0 is measured analytically) */
+    ZR_SKIP_FLAT_DIFFUSE = 4 /* the diffuse lobe of a flat part hit by this
+                            very ray counts nothing (transfer covers it) */
 };
 vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count);

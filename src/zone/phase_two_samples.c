@@ -1,0 +1,234 @@
+/* Phase Two, step one: the sample list of every pixel.
+ *
+ * A pixel whose corner and sub-pixel signatures agree sees one smooth
+ * surface: its g x g samples are shaded, each with weight 1/g^2.  Where they
+ * differ, an edge crosses the pixel: a 16 x 16 grid measures the coverage of
+ * each surface (group of equal signatures), and each group is shaded on the
+ * samples of a sparse 4 x 4 subset that fall in it (or on its first sample
+ * when it misses the subset), weighted by its coverage.  Light parts seen at
+ * a corner or a sample are listed for the exact level-0 coverage. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "geom/shapes.h"
+#include "zone/phase_two.h"
+
+#define EDGE_GRID 16   /* sub-pixel grid for coverage at edges */
+#define EDGE_SHADE 4   /* shaded samples per side of that grid */
+#define SEEN_MAX 8     /* light parts listed per pixel */
+
+/* What a camera ray sees, as a number: the parts along its specular chain
+ * (the transmitted branch through glass).  Sub-pixel samples with the same
+ * signature see one smooth surface; differing ones mark an edge.  *first is
+ * the ray's first hit. */
+static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, int steps, uint64_t *rays,
+                              hit *first)
+{
+    uint32_t sig = 0x811c9dc5u;
+    for (int k = 0; k <= steps; k++) {
+        hit h = accel_intersect(rs, o, d);
+        (*rays)++;
+        if (k == 0)
+            *first = h;
+        sig = (sig ^ (uint32_t)(h.part + 1)) * 16777619u;
+        if (h.part < 0)
+            break;
+        const rs_part *p = &rs->parts[h.part];
+        const rs_object *m = &rs->objects[p->object];
+        if (p->is_light || m->weight[LOBE_DIFFUSE] >= 1.0f)
+            break;
+        vec3f x = f3_madd(o, d, h.t);
+        vec3f ng = shape_normal(p, x);
+        vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
+        if (m->weight[LOBE_REFRACTIVE] > 0.0f) {
+            /* Direction changes matter little for the signature: go on
+             * straight through, off the far side of the surface. */
+            o = ray_offset(x, f3_neg(n));
+        } else {
+            d = f3_sub(d, f3_scale(n, 2.0f * f3_dot(d, n)));
+            o = ray_offset(x, n);
+        }
+    }
+    return sig;
+}
+
+typedef struct seen_lights {
+    int part[SEEN_MAX];
+    int count;
+} seen_lights;
+
+static void note_light(const rscene *rs, seen_lights *s, int part)
+{
+    if (part < 0 || !rs->parts[part].is_light)
+        return;
+    for (int i = 0; i < s->count; i++)
+        if (s->part[i] == part)
+            return;
+    if (s->count < SEEN_MAX)
+        s->part[s->count++] = part;
+}
+
+static int push_sample(p2_row *row, vec3f o, vec3f d, hit h, double w)
+{
+    if (row->sample_count == row->sample_capacity) {
+        size_t cap = row->sample_capacity ? 2 * row->sample_capacity : 1024;
+        p2_sample *ns = realloc(row->samples, cap * sizeof *ns);
+        if (!ns)
+            return 0;
+        row->samples = ns;
+        row->sample_capacity = cap;
+    }
+    p2_sample s = {o, d, h.t, h.part, w};
+    row->samples[row->sample_count++] = s;
+    return 1;
+}
+
+static int push_lights(p2_row *row, const seen_lights *s)
+{
+    if (row->light_count + (size_t)s->count > row->light_capacity) {
+        size_t cap = row->light_capacity ? 2 * row->light_capacity : 64;
+        while (cap < row->light_count + (size_t)s->count)
+            cap *= 2;
+        int *nl = realloc(row->lights, cap * sizeof *nl);
+        if (!nl)
+            return 0;
+        row->lights = nl;
+        row->light_capacity = cap;
+    }
+    for (int i = 0; i < s->count; i++)
+        row->lights[row->light_count++] = s->part[i];
+    return 1;
+}
+
+/* The samples of pixel (px, py) given its corner signatures. */
+static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners[4],
+                         seen_lights *lights, p2_row *row, uint64_t *rays)
+{
+    const rscene *rs = &c->r->rs;
+    int g = c->g, hi = c->hi;
+    uint32_t first = corners[0];
+    int edge = corners[1] != first || corners[2] != first || corners[3] != first;
+    size_t start = row->sample_count;
+    vec3f org, dir;
+    hit h;
+    for (int sy = 0; sy < g; sy++)
+        for (int sx = 0; sx < g; sx++) {
+            cam_ray(&c->c, (float)px + (sx + 0.5f) / g, (float)py + (sy + 0.5f) / g, &org, &dir);
+            if (ray_signature(rs, org, dir, hi, rays, &h) != first)
+                edge = 1;
+            note_light(rs, lights, h.part);
+            if (!edge && !push_sample(row, org, dir, h, 1.0 / (g * g)))
+                return 0;
+        }
+    if (!edge)
+        return 1;
+    row->sample_count = start;
+
+    enum { N = EDGE_GRID * EDGE_GRID };
+    uint32_t sigs[N], group_sig[N];
+    hit hits[N];
+    int group_of[N], group_count[N], group_shaded[N];
+    int groups = 0;
+    const int step = EDGE_GRID / EDGE_SHADE;
+    for (int i = 0; i < N; i++) {
+        int sx = i % EDGE_GRID, sy = i / EDGE_GRID;
+        cam_ray(&c->c, (float)px + (sx + 0.5f) / EDGE_GRID, (float)py + (sy + 0.5f) / EDGE_GRID,
+                &org, &dir);
+        sigs[i] = ray_signature(rs, org, dir, hi, rays, &hits[i]);
+        note_light(rs, lights, hits[i].part);
+        int k = 0;
+        while (k < groups && group_sig[k] != sigs[i])
+            k++;
+        if (k == groups) {
+            group_sig[k] = sigs[i];
+            group_count[k] = 0;
+            group_shaded[k] = 0;
+            groups++;
+        }
+        group_of[i] = k;
+        group_count[k]++;
+        if ((sx % step == step / 2) && (sy % step == step / 2))
+            group_shaded[k]++;
+    }
+    /* The subset's samples, weighted by their group's coverage. */
+    for (int i = 0; i < N; i++) {
+        int sx = i % EDGE_GRID, sy = i / EDGE_GRID, k = group_of[i];
+        if (!((sx % step == step / 2) && (sy % step == step / 2)))
+            continue;
+        cam_ray(&c->c, (float)px + (sx + 0.5f) / EDGE_GRID, (float)py + (sy + 0.5f) / EDGE_GRID,
+                &org, &dir);
+        double w = (double)group_count[k] / (group_shaded[k] * EDGE_GRID * EDGE_GRID);
+        if (!push_sample(row, org, dir, hits[i], w))
+            return 0;
+    }
+    /* Surfaces too small to meet the subset: their first sample. */
+    for (int k = 0; k < groups; k++) {
+        if (group_shaded[k])
+            continue;
+        for (int i = 0; i < N; i++)
+            if (group_of[i] == k) {
+                int sx = i % EDGE_GRID, sy = i / EDGE_GRID;
+                cam_ray(&c->c, (float)px + (sx + 0.5f) / EDGE_GRID,
+                        (float)py + (sy + 0.5f) / EDGE_GRID, &org, &dir);
+                double w = (double)group_count[k] / (EDGE_GRID * EDGE_GRID);
+                if (!push_sample(row, org, dir, hits[i], w))
+                    return 0;
+                break;
+            }
+    }
+    return 1;
+}
+
+int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
+{
+    const rscene *rs = &c->r->rs;
+    int w = c->c.width, w1 = w + 1;
+    if (!row->pixel_first) {
+        row->width = w;
+        row->pixel_first = malloc((size_t)w1 * sizeof *row->pixel_first);
+        row->light_first = malloc((size_t)w1 * sizeof *row->light_first);
+        row->corner = malloc(2 * (size_t)w1 * sizeof *row->corner);
+        row->corner_part = malloc(2 * (size_t)w1 * sizeof *row->corner_part);
+        if (!row->pixel_first || !row->light_first || !row->corner || !row->corner_part)
+            return 0;
+    }
+    row->sample_count = 0;
+    row->light_count = 0;
+    /* Signatures at the pixel corners of this row (top and bottom). */
+    for (int k = 0; k < 2 * w1; k++) {
+        vec3f org, dir;
+        hit h;
+        cam_ray(&c->c, (float)(k % w1), (float)(y + k / w1), &org, &dir);
+        row->corner[k] = ray_signature(rs, org, dir, c->hi, rays, &h);
+        row->corner_part[k] = h.part;
+    }
+    for (int x = 0; x < w; x++) {
+        uint32_t cs[4] = {row->corner[x], row->corner[x + 1], row->corner[w1 + x],
+                          row->corner[w1 + x + 1]};
+        seen_lights lights = {{0}, 0};
+        note_light(rs, &lights, row->corner_part[x]);
+        note_light(rs, &lights, row->corner_part[x + 1]);
+        note_light(rs, &lights, row->corner_part[w1 + x]);
+        note_light(rs, &lights, row->corner_part[w1 + x + 1]);
+        row->pixel_first[x] = row->sample_count;
+        row->light_first[x] = row->light_count;
+        if (!pixel_samples(c, x, y, cs, &lights, row, rays) || !push_lights(row, &lights))
+            return 0;
+    }
+    row->pixel_first[w] = row->sample_count;
+    row->light_first[w] = row->light_count;
+    return 1;
+}
+
+void p2_row_free(p2_row *row)
+{
+    free(row->samples);
+    free(row->pixel_first);
+    free(row->lights);
+    free(row->light_first);
+    free(row->corner);
+    free(row->corner_part);
+    memset(row, 0, sizeof *row);
+}

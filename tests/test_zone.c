@@ -1,0 +1,517 @@
+/* The zone tracer's rules that need no reference image: determinism (two
+ * runs, thread counts), the two Phase Two strategies giving the same bytes,
+ * the per-zone terms adding up to the plain shading, the forest file (round
+ * trip, rejections), camera moves without Phase One, levels adding up to
+ * the depth image, single lights adding up to all lights.  Small images,
+ * quality 0: seconds, also under AddressSanitizer. */
+#define _POSIX_C_SOURCE 200809L
+#include "test_support.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/render_internal.h"
+#include "zone/phase_two.h"
+#include "zonetrace/render.h"
+#include "zonetrace/scene.h"
+
+#define W 20
+#define H 16
+
+#define DIFFUSE(r, g, b) "{\"character\": {\"diffuse\": 1, \"metallic\": 0, " \
+    "\"reflecting\": 0, \"refractive\": 0}, \"color\": [" #r ", " #g ", " #b "]}"
+
+/* A small open box: diffuse walls, two ceiling lights (two light objects),
+ * a mirror sphere, a glass sphere and a half-metallic triangle; SKY is
+ * spliced in for the variant with a sky, seen past the box. */
+#define BOX_SCENE(SKY, BACK_COLOR)                                                       \
+    "{\"scene\": [" SKY                                                                  \
+    "{\"lighttriangle\": {\"points\": [[-1, 4.9, -1], [1, 4.9, -1], [-1, 4.9, 1]], "     \
+    "\"emission\": [8, 8, 7]}},"                                                         \
+    "{\"lighttriangle\": {\"points\": [[1, 4.9, 1], [-1, 4.9, 1], [1, 4.9, -1]], "       \
+    "\"emission\": [6, 7, 8]}},"                                                         \
+    "{\"thing\": {\"material\": " DIFFUSE(0.7, 0.7, 0.7) ", \"parts\": ["                 \
+    "{\"triangle\": {\"points\": [[-5, -5, -5], [5, -5, 5], [5, -5, -5]]}},"            \
+    "{\"triangle\": {\"points\": [[-5, -5, -5], [-5, -5, 5], [5, -5, 5]]}},"            \
+    "{\"triangle\": {\"points\": [[-5, 5, -5], [5, 5, -5], [5, 5, 5]]}},"               \
+    "{\"triangle\": {\"points\": [[-5, 5, -5], [5, 5, 5], [-5, 5, 5]]}}]}},"            \
+    "{\"thing\": {\"material\": " BACK_COLOR ", \"parts\": ["                             \
+    "{\"triangle\": {\"points\": [[-5, -5, -5], [5, -5, -5], [5, 5, -5]]}},"            \
+    "{\"triangle\": {\"points\": [[-5, -5, -5], [5, 5, -5], [-5, 5, -5]]}}]}},"         \
+    "{\"thing\": {\"material\": " DIFFUSE(0.7, 0.15, 0.1) ", \"parts\": ["                \
+    "{\"triangle\": {\"points\": [[-5, -5, -5], [-5, 5, -5], [-5, 5, 5]]}},"            \
+    "{\"triangle\": {\"points\": [[-5, -5, -5], [-5, 5, 5], [-5, -5, 5]]}}]}},"         \
+    "{\"sphere\": {\"center\": [-2, -3.5, -1], \"radius\": 1.5, \"material\": "          \
+    "{\"character\": {\"diffuse\": 0, \"metallic\": 0, \"reflecting\": 1, "              \
+    "\"refractive\": 0}, \"color\": [0.9, 0.9, 0.9]}}},"                                 \
+    "{\"sphere\": {\"center\": [2, -3.8, 1], \"radius\": 1.2, \"material\": "            \
+    "{\"character\": {\"diffuse\": 0, \"metallic\": 0, \"reflecting\": 0, "              \
+    "\"refractive\": 1}, \"color\": [1, 1, 1], \"refractiveindex\": 1.5}}},"             \
+    "{\"triangle\": {\"points\": [[5, -5, -3], [5, 2, -3], [5, -5, 3]], \"material\": "  \
+    "{\"character\": {\"diffuse\": 0.5, \"metallic\": 0.5, \"reflecting\": 0, "          \
+    "\"refractive\": 0}, \"color\": [0.9, 0.7, 0.3], \"refractiveindex\": 0.3}}}"        \
+    "], \"camera\": {\"viewpoint\": [0.3, 0.2, 14], \"screen\": [[-1, 1, 13], "          \
+    "[1, 1, 13], [-1, -1, 13], [1, -1, 13]], \"gridresolution\": [20, 16]}}"
+
+static const char *box_text = BOX_SCENE("", DIFFUSE(0.6, 0.6, 0.6));
+static const char *other_box_text = BOX_SCENE("", DIFFUSE(0.6, 0.6, 0.5));
+static const char *sky_box_text =
+    BOX_SCENE("{\"sky\": {\"color\": [0.3, 0.4, 0.6]}},", DIFFUSE(0.6, 0.6, 0.6));
+
+static zt_scene *scene_from(const char *text)
+{
+    zt_scene *s = NULL;
+    zt_error err = {0};
+    if (zt_scene_load_string(text, strlen(text), "box.json", &s, &err) != ZT_OK)
+        fail_msg("scene does not load: %s", err.message);
+    return s;
+}
+
+static zt_render_options zone_options(int depth, int threads)
+{
+    zt_render_options o = zt_render_options_default();
+    o.method = ZT_METHOD_ZONE;
+    o.depth = depth;
+    o.threads = threads;
+    o.quality = 0;
+    return o;
+}
+
+static zt_image *render(const zt_scene *s, const zt_render_options *o, zt_render_stats *stats)
+{
+    zt_image *img = NULL;
+    zt_error err = {0};
+    if (zt_render(s, o, &img, stats, &err) != ZT_OK)
+        fail_msg("render failed: %s", err.message);
+    return img;
+}
+
+static zt_renderer *renderer(const zt_scene *s, const zt_render_options *o)
+{
+    zt_renderer *r = NULL;
+    zt_error err = {0};
+    if (zt_renderer_create(s, o, &r, &err) != ZT_OK)
+        fail_msg("renderer: %s", err.message);
+    return r;
+}
+
+static zt_image *accumulate(zt_renderer *r, const zt_scene *s, zt_render_stats *stats)
+{
+    zt_camera cam = zt_scene_get_camera(s);
+    zt_image *img = zt_image_create(cam.width, cam.height);
+    assert_non_null(img);
+    zt_error err = {0};
+    if (zt_renderer_accumulate(r, 0, 1, img, stats, &err) != ZT_OK)
+        fail_msg("accumulate: %s", err.message);
+    return img;
+}
+
+static size_t floats(const zt_image *a) { return (size_t)a->width * a->height * 3; }
+
+static void assert_same_bytes(const zt_image *a, const zt_image *b, const char *what)
+{
+    assert_int_equal(a->width, b->width);
+    assert_int_equal(a->height, b->height);
+    if (memcmp(a->pixels, b->pixels, floats(a) * sizeof(float)) != 0) {
+        for (size_t i = 0; i < floats(a); i++)
+            if (memcmp(&a->pixels[i], &b->pixels[i], sizeof(float)) != 0)
+                fail_msg("%s: float %zu differs: %.9g vs %.9g", what, i, a->pixels[i],
+                         b->pixels[i]);
+    }
+}
+
+/* sqrt(mean((a-b)^2)) / mean(b), as `zonetrace compare` computes it. */
+static double rel_rmse(const zt_image *a, const zt_image *b)
+{
+    double se = 0, sum = 0;
+    size_t n = floats(a);
+    for (size_t i = 0; i < n; i++) {
+        double d = (double)a->pixels[i] - b->pixels[i];
+        se += d * d;
+        sum += b->pixels[i];
+    }
+    return sqrt(se / n) / (sum / n);
+}
+
+static double image_mean(const zt_image *a)
+{
+    double sum = 0;
+    for (size_t i = 0; i < floats(a); i++)
+        sum += a->pixels[i];
+    return sum / floats(a);
+}
+
+/* ---------------------------------------------------------------------- */
+
+static void test_deterministic(void **state)
+{
+    (void)state;
+    zt_scene *s = scene_from(box_text);
+    zt_render_options o1 = zone_options(2, 1), o2 = zone_options(2, 2);
+    zt_image *a = render(s, &o2, NULL), *b = render(s, &o2, NULL), *c = render(s, &o1, NULL);
+    assert_true(image_mean(a) > 0);
+    assert_same_bytes(a, b, "two runs");
+    assert_same_bytes(a, c, "1 vs 2 threads");
+    zt_image_release(a);
+    zt_image_release(b);
+    zt_image_release(c);
+    zt_scene_release(s);
+}
+
+/* One forest, four Phase Twos: both strategies at 1 and 2 threads (the
+ * options are switched inside the renderer to spare Phase One). */
+static void check_strategies(const char *text, int depth, int level)
+{
+    zt_scene *s = scene_from(text);
+    zt_render_options o = zone_options(depth, 1);
+    o.level = level;
+    zt_renderer *r = renderer(s, &o);
+    zt_image *img[4];
+    for (int i = 0; i < 4; i++) {
+        r->options.threads = 1 + i % 2;
+        r->options.strategy = i < 2 ? ZT_STRATEGY_PIXEL : ZT_STRATEGY_ZONE;
+        img[i] = accumulate(r, s, NULL);
+    }
+    assert_true(image_mean(img[0]) > 0);
+    assert_same_bytes(img[0], img[1], "pixel strategy, 1 vs 2 threads");
+    assert_same_bytes(img[0], img[2], "pixel vs zone strategy");
+    assert_same_bytes(img[0], img[3], "pixel vs zone strategy, 2 threads");
+    for (int i = 0; i < 4; i++)
+        zt_image_release(img[i]);
+    zt_renderer_release(r);
+    zt_scene_release(s);
+}
+
+static void test_strategies_identical(void **state)
+{
+    (void)state;
+    check_strategies(box_text, 3, -1);
+    check_strategies(box_text, 2, 1);
+    check_strategies(sky_box_text, 2, -1);
+}
+
+/* The per-zone terms add up to one zone_radiance call per sample. */
+static void check_terms(const char *text, int depth)
+{
+    zt_scene *s = scene_from(text);
+    zt_render_options o = zone_options(depth, 2);
+    zt_renderer *r = renderer(s, &o);
+    zt_image *terms = accumulate(r, s, NULL);
+    zt_image *ref = zt_image_create(W, H);
+    zt_error err = {0};
+    assert_int_equal(zone_accumulate_reference(r, ref, &err), ZT_OK);
+    double e = rel_rmse(terms, ref);
+    if (!(e < 1e-5))
+        fail_msg("terms vs plain shading: rel_rmse %g", e);
+    zt_image_release(terms);
+    zt_image_release(ref);
+    zt_renderer_release(r);
+    zt_scene_release(s);
+}
+
+static void test_terms_sum_to_shading(void **state)
+{
+    (void)state;
+    check_terms(box_text, 3);
+    check_terms(sky_box_text, 2);
+}
+
+static void test_levels_sum_to_depth(void **state)
+{
+    (void)state;
+    zt_scene *s = scene_from(box_text);
+    const int depth = 3;
+    zt_render_options o = zone_options(depth, 2);
+    zt_image *all = render(s, &o, NULL);
+    zt_image *sum = zt_image_create(W, H);
+    for (int l = 0; l <= depth; l++) {
+        o.level = l;
+        zt_image *li = render(s, &o, NULL);
+        assert_true(l == 0 || image_mean(li) > 0);
+        for (size_t i = 0; i < floats(sum); i++)
+            sum->pixels[i] += li->pixels[i];
+        zt_image_release(li);
+    }
+    double e = rel_rmse(sum, all);
+    if (!(e < 1e-5))
+        fail_msg("levels 0..%d vs depth %d: rel_rmse %g", depth, depth, e);
+    zt_image_release(sum);
+    zt_image_release(all);
+    zt_scene_release(s);
+}
+
+static void test_lights_add_up(void **state)
+{
+    (void)state;
+    zt_scene *s = scene_from(box_text);
+    zt_render_options o = zone_options(2, 2);
+    zt_image *all = render(s, &o, NULL);
+    o.lights_off_count = 1;
+    o.lights_off[0] = 1;
+    zt_image *a = render(s, &o, NULL);
+    o.lights_off[0] = 0;
+    zt_image *b = render(s, &o, NULL);
+    assert_true(image_mean(a) > 0.1 * image_mean(all));
+    assert_true(image_mean(b) > 0.1 * image_mean(all));
+    for (size_t i = 0; i < floats(a); i++)
+        a->pixels[i] += b->pixels[i];
+    double e = rel_rmse(a, all);
+    if (!(e < 1e-5))
+        fail_msg("light 0 + light 1 vs both: rel_rmse %g", e);
+    zt_image_release(a);
+    zt_image_release(b);
+    zt_image_release(all);
+    zt_scene_release(s);
+}
+
+static void test_forest_round_trip(void **state)
+{
+    (void)state;
+    zt_scene *s = scene_from(box_text);
+    const char *path = test_tmp_path("box.forest");
+    zt_render_options o = zone_options(3, 2);
+    zt_renderer *r = renderer(s, &o);
+    zt_error err = {0};
+    assert_int_equal(zt_renderer_save_forest(r, path, &err), ZT_OK);
+    zt_render_stats built_stats;
+    zt_image *built = accumulate(r, s, &built_stats);
+    assert_int_equal(built_stats.forest_loaded, 0);
+    assert_true(built_stats.zones > 0 && built_stats.memory_bytes > 0);
+
+    for (int strategy = 0; strategy < 2; strategy++) {
+        zt_render_options lo = o;
+        lo.forest_file = path;
+        lo.strategy = strategy ? ZT_STRATEGY_ZONE : ZT_STRATEGY_PIXEL;
+        lo.threads = 1 + strategy;
+        zt_render_stats stats;
+        zt_image *loaded = render(s, &lo, &stats);
+        assert_same_bytes(built, loaded, "built vs loaded forest");
+        assert_int_equal(stats.forest_loaded, 1);
+        assert_int_equal(stats.zones, built_stats.zones);
+        assert_int_equal(stats.zones_pruned, built_stats.zones_pruned);
+        assert_int_equal(stats.memory_bytes, built_stats.memory_bytes);
+        for (int l = 0; l < 32; l++)
+            assert_int_equal(stats.zones_per_level[l], built_stats.zones_per_level[l]);
+        zt_image_release(loaded);
+    }
+    /* Saving a loaded forest gives the same file. */
+    zt_render_options lo = o;
+    lo.forest_file = path;
+    zt_renderer *r2 = renderer(s, &lo);
+    const char *path2 = test_tmp_path("box2.forest");
+    assert_int_equal(zt_renderer_save_forest(r2, path2, &err), ZT_OK);
+    size_t n1, n2;
+    char *f1 = test_read_file(path, &n1), *f2 = test_read_file(path2, &n2);
+    assert_non_null(f1);
+    assert_non_null(f2);
+    assert_int_equal(n1, n2);
+    assert_memory_equal(f1, f2, n1);
+    free(f1);
+    free(f2);
+    zt_renderer_release(r2);
+
+    /* A path-tracing renderer has no forest. */
+    zt_render_options po = zt_render_options_default();
+    po.spp = 1;
+    zt_renderer *pr = renderer(s, &po);
+    assert_int_equal(zt_renderer_save_forest(pr, path2, &err), ZT_ERR_ARGUMENT);
+    zt_renderer_release(pr);
+
+    zt_image_release(built);
+    zt_renderer_release(r);
+    zt_scene_release(s);
+}
+
+/* Creating a renderer from path with options o must fail with status and a
+ * message naming the file and containing what. */
+static void expect_rejected(const zt_scene *s, zt_render_options o, const char *path,
+                            zt_status status, const char *what)
+{
+    o.forest_file = path;
+    zt_renderer *r = NULL;
+    zt_error err = {0};
+    zt_status st = zt_renderer_create(s, &o, &r, &err);
+    if (st != status)
+        fail_msg("loading %s: status %d (%s), expected %d", path, st, err.message, status);
+    assert_null(r);
+    if (!strstr(err.message, path) || !strstr(err.message, what))
+        fail_msg("message '%s' lacks '%s' or the file name", err.message, what);
+}
+
+static void write_bytes(const char *path, const char *data, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, n, f), n);
+    fclose(f);
+}
+
+static void test_forest_rejections(void **state)
+{
+    (void)state;
+    zt_scene *s = scene_from(box_text), *other = scene_from(other_box_text);
+    const char *path = test_tmp_path("reject.forest");
+    zt_render_options o = zone_options(2, 2);
+    zt_renderer *r = renderer(s, &o);
+    zt_error err = {0};
+    assert_int_equal(zt_renderer_save_forest(r, path, &err), ZT_OK);
+    zt_renderer_release(r);
+
+    expect_rejected(other, o, path, ZT_ERR_PARSE, "another scene");
+    zt_render_options x = o;
+    x.depth = 3;
+    expect_rejected(s, x, path, ZT_ERR_PARSE, "depth 2");
+    x = o;
+    x.cutoff = 0.5;
+    expect_rejected(s, x, path, ZT_ERR_PARSE, "cutoff");
+    x = o;
+    x.quality = 1;
+    expect_rejected(s, x, path, ZT_ERR_PARSE, "quality");
+    x = o;
+    x.lights_off_count = 1;
+    x.lights_off[0] = 1;
+    expect_rejected(s, x, path, ZT_ERR_PARSE, "lights off");
+    expect_rejected(s, o, test_tmp_path("missing.forest"), ZT_ERR_READ, "cannot open");
+
+    size_t n;
+    char *data = test_read_file(path, &n);
+    assert_non_null(data);
+    const char *bad = test_tmp_path("bad.forest");
+    write_bytes(bad, data, n / 2);
+    expect_rejected(s, o, bad, ZT_ERR_PARSE, "truncated");
+    write_bytes(bad, data, 10);
+    expect_rejected(s, o, bad, ZT_ERR_PARSE, "truncated");
+    data[n / 2] ^= 0x10;
+    write_bytes(bad, data, n);
+    expect_rejected(s, o, bad, ZT_ERR_PARSE, "corrupt");
+    data[n / 2] ^= 0x10;
+    data[8] = 99; /* the format version */
+    write_bytes(bad, data, n);
+    expect_rejected(s, o, bad, ZT_ERR_PARSE, "version 99");
+    write_bytes(bad, "{\"scene\": []}", 13);
+    expect_rejected(s, o, bad, ZT_ERR_PARSE, "not a zonetrace forest file");
+    free(data);
+
+    /* The camera is not part of the forest: another view loads it. */
+    zt_camera cam = zt_scene_get_camera(s);
+    cam.viewpoint[0] += 1;
+    cam.width = 12;
+    cam.height = 10;
+    zt_scene_set_camera(s, &cam);
+    o.forest_file = path;
+    r = renderer(s, &o);
+    zt_renderer_release(r);
+    zt_scene_release(other);
+    zt_scene_release(s);
+}
+
+static void test_camera_moves_without_phase_one(void **state)
+{
+    (void)state;
+    zt_scene *s = scene_from(box_text);
+    zt_render_options o = zone_options(2, 2);
+    zt_renderer *r = renderer(s, &o);
+    const void *forest = r->forest;
+    zt_render_stats st1, st2;
+    zt_image *a = accumulate(r, s, &st1);
+    assert_true(st1.phase_one_seconds > 0);
+
+    zt_camera cam = zt_scene_get_camera(s);
+    for (int k = 0; k < 4; k++) {
+        cam.screen[k][0] += 0.8;
+        cam.screen[k][1] -= 0.3;
+    }
+    cam.viewpoint[0] += 0.8;
+    cam.viewpoint[1] -= 0.3;
+    zt_error err = {0};
+    assert_int_equal(zt_renderer_set_camera(r, &cam, &err), ZT_OK);
+    zt_scene_set_camera(s, &cam);
+    zt_image *b = accumulate(r, s, &st2);
+    assert_ptr_equal(r->forest, forest);
+    assert_true(st2.phase_one_seconds == 0.0);
+    assert_true(st2.phase_two_seconds > 0);
+    assert_true(rel_rmse(a, b) > 1e-3); /* the view did change */
+
+    /* The moved view from a saved forest: the same bytes. */
+    const char *path = test_tmp_path("moved.forest");
+    assert_int_equal(zt_renderer_save_forest(r, path, &err), ZT_OK);
+    o.forest_file = path;
+    o.strategy = ZT_STRATEGY_ZONE;
+    zt_renderer *r2 = renderer(s, &o);
+    zt_image *c = accumulate(r2, s, NULL);
+    assert_same_bytes(b, c, "moved camera: kept vs loaded forest");
+    zt_image_release(a);
+    zt_image_release(b);
+    zt_image_release(c);
+    zt_renderer_release(r2);
+    zt_renderer_release(r);
+    zt_scene_release(s);
+}
+
+/* The command line: --save-forest, --load-forest, -v statistics. */
+static void test_cli(void **state)
+{
+    (void)state;
+    const char *scene = test_write_file("cli_box.json", box_text);
+    char forest[512], a[512], b[512], args[2048];
+    snprintf(forest, sizeof forest, "%s", test_tmp_path("cli.forest"));
+    snprintf(a, sizeof a, "%s", test_tmp_path("cli_a.pfm"));
+    snprintf(b, sizeof b, "%s", test_tmp_path("cli_b.pfm"));
+    char *out = NULL;
+    snprintf(args, sizeof args, "render '%s' --method zone --depth 2 --quality 0 -o '%s' "
+             "--save-forest '%s' -v", scene, a, forest);
+    int code = test_run_cli(args, &out);
+    if (code != 0)
+        fail_msg("render --save-forest: exit %d: %s", code, out ? out : "");
+    assert_non_null(strstr(out, "zones: level 0: 2"));
+    assert_non_null(strstr(out, "pruned"));
+    assert_non_null(strstr(out, "forest memory"));
+    assert_non_null(strstr(out, "phase one"));
+    free(out);
+    snprintf(args, sizeof args, "render '%s' --method zone --depth 2 --quality 0 -o '%s' "
+             "--load-forest '%s' --strategy zone -v", scene, b, forest);
+    code = test_run_cli(args, &out);
+    if (code != 0)
+        fail_msg("render --load-forest: exit %d: %s", code, out ? out : "");
+    assert_non_null(strstr(out, "read from"));
+    free(out);
+    size_t na, nb;
+    char *da = test_read_file(a, &na), *db = test_read_file(b, &nb);
+    assert_non_null(da);
+    assert_non_null(db);
+    assert_int_equal(na, nb);
+    assert_memory_equal(da, db, na);
+    free(da);
+    free(db);
+    /* Other options: exit 3 (invalid input) with the reason. */
+    snprintf(args, sizeof args, "render '%s' --method zone --depth 3 --quality 0 -o '%s' "
+             "--load-forest '%s'", scene, b, forest);
+    code = test_run_cli(args, &out);
+    assert_int_equal(code, 3);
+    assert_non_null(strstr(out, "other options"));
+    free(out);
+    snprintf(args, sizeof args, "render '%s' --method path -o '%s' --load-forest '%s'", scene,
+             b, forest);
+    code = test_run_cli(args, &out);
+    assert_int_equal(code, 1);
+    free(out);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_strategies_identical),
+        cmocka_unit_test(test_terms_sum_to_shading),
+        cmocka_unit_test(test_levels_sum_to_depth),
+        cmocka_unit_test(test_lights_add_up),
+        cmocka_unit_test(test_forest_round_trip),
+        cmocka_unit_test(test_forest_rejections),
+        cmocka_unit_test(test_camera_moves_without_phase_one),
+        cmocka_unit_test(test_cli),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
