@@ -147,8 +147,11 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         prev_x = x;
         d = bs.wi;
 
-        if (k >= RR_START) {
-            float q = fminf(0.95f, f3_max(beta));
+        /* Russian roulette: a path whose throughput has fallen below 1
+         * survives with probability equal to it, and is boosted by as
+         * much, which keeps the estimate unbiased. */
+        float q = f3_max(beta);
+        if (k >= RR_START && q < 1.0f) {
             if (u_1d[3] >= q)
                 break;
             beta = f3_scale(beta, 1.0f / q);
