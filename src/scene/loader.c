@@ -21,28 +21,6 @@
 /* No scene needs more; a bigger file is taken for a mistake. */
 #define MAX_SCENE_BYTES ((size_t)64 << 20)
 
-/* Where a jansson error is: the start of the token it names ("near 'x'"),
- * or for an early end the end of the last token. */
-static size_t syntax_error_offset(const char *text, size_t length,
-                                  const json_error_t *e)
-{
-    size_t pos = e->position > 0 ? (size_t)e->position : 0;
-    if (pos > length)
-        pos = length;
-    if (strstr(e->text, "near end of file")) {
-        while (pos > 0 && strchr(" \t\r\n", text[pos - 1]))
-            pos--;
-        return pos;
-    }
-    const char *near = strstr(e->text, "near '");
-    const char *last = strrchr(e->text, '\'');
-    if (near && last > near + 6) {
-        size_t len = (size_t)(last - (near + 6));
-        if (len <= pos && memcmp(text + pos - len, near + 6, len) == 0)
-            return pos - len;
-    }
-    return pos > 0 ? pos - 1 : 0;
-}
 
 static zt_status load_top_level(load_ctx *ctx, const json_t *root)
 {
@@ -90,7 +68,7 @@ static zt_status load_parsed(const char *name, const char *original,
     if (!root) {
         int oom = json_error_code(&jerr) == json_error_out_of_memory;
         status = load_fail_offset(&ctx, oom ? ZT_ERR_MEMORY : ZT_ERR_PARSE,
-                                  syntax_error_offset(strict->text, strict->length, &jerr),
+                                  json_syntax_error_offset(strict->text, strict->length, &jerr),
                                   "syntax error: %s", jerr.text);
     } else {
         json_positions *positions = json_positions_build(strict->text,

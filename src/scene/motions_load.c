@@ -232,28 +232,6 @@ static zt_status load_top(load_ctx *ctx, const json_t *root, zt_motions *ms)
     return ZT_OK;
 }
 
-/* Where a jansson error is: the start of the token it names ("near 'x'"),
- * or for an early end the end of the last token (as the scene loader). */
-static size_t syntax_error_offset(const char *text, size_t length,
-                                  const json_error_t *e)
-{
-    size_t pos = e->position > 0 ? (size_t)e->position : 0;
-    if (pos > length)
-        pos = length;
-    if (strstr(e->text, "near end of file")) {
-        while (pos > 0 && strchr(" \t\r\n", text[pos - 1]))
-            pos--;
-        return pos;
-    }
-    const char *near = strstr(e->text, "near '");
-    const char *last = strrchr(e->text, '\'');
-    if (near && last > near + 6) {
-        size_t len = (size_t)(last - (near + 6));
-        if (len <= pos && memcmp(text + pos - len, near + 6, len) == 0)
-            return pos - len;
-    }
-    return pos > 0 ? pos - 1 : 0;
-}
 
 static zt_motions *motions_new(const char *name)
 {
@@ -327,7 +305,7 @@ zt_status zt_motions_load_string(const char *text, size_t length,
         if (!root) {
             int oom = json_error_code(&jerr) == json_error_out_of_memory;
             status = load_fail_offset(&ctx, oom ? ZT_ERR_MEMORY : ZT_ERR_PARSE,
-                                      syntax_error_offset(copy, length, &jerr),
+                                      json_syntax_error_offset(copy, length, &jerr),
                                       "syntax error: %s", jerr.text);
         } else {
             json_positions *positions = json_positions_build(copy, length, root);

@@ -1,6 +1,7 @@
 /* Offsets to lines and columns, through the inserts of the legacy rewrite. */
 #include "scene/source_map.h"
 
+#include <jansson.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -86,4 +87,25 @@ int source_map_locate(const source_map *map, size_t original, int *line,
     *line = (int)(lo + 1);
     *column = col;
     return 1;
+}
+
+size_t json_syntax_error_offset(const char *text, size_t length,
+                                const struct json_error_t *e)
+{
+    size_t pos = e->position > 0 ? (size_t)e->position : 0;
+    if (pos > length)
+        pos = length;
+    if (strstr(e->text, "near end of file")) {
+        while (pos > 0 && strchr(" \t\r\n", text[pos - 1]))
+            pos--;
+        return pos;
+    }
+    const char *near = strstr(e->text, "near '");
+    const char *last = strrchr(e->text, '\'');
+    if (near && last > near + 6) {
+        size_t len = (size_t)(last - (near + 6));
+        if (len <= pos && memcmp(text + pos - len, near + 6, len) == 0)
+            return pos - len;
+    }
+    return pos > 0 ? pos - 1 : 0;
 }

@@ -36,4 +36,11 @@ size_t source_map_original(const source_map *map, size_t parsed);
 int source_map_locate(const source_map *map, size_t original, int *line,
                       int *column);
 
+struct json_error_t;
+
+/* Where in text a jansson syntax error is: the start of the token it names
+ * ("near 'x'"), or for an early end the end of the last token. */
+size_t json_syntax_error_offset(const char *text, size_t length,
+                                const struct json_error_t *e);
+
 #endif
