@@ -276,6 +276,32 @@ static int light_polygon(const direct_ctx *c, int light, vec3 x, light_frame *f,
     return 1;
 }
 
+static vec3 lift(const light_frame *f, double a, double b)
+{
+    return v3_add(f->origin, v3_add(v3_scale(f->u, a), v3_scale(f->v, b)));
+}
+
+/* Whether a finite part's bounding box meets the box [lo, hi] (planes
+ * always do). */
+static int part_meets_box(const part *o, vec3 lo, vec3 hi)
+{
+    vec3 a, b;
+    if (o->shape == SHAPE_TRIANGLE) {
+        a = b = o->p[0];
+        for (int i = 1; i < 3; i++) {
+            a = v3(fmin(a.x, o->p[i].x), fmin(a.y, o->p[i].y), fmin(a.z, o->p[i].z));
+            b = v3(fmax(b.x, o->p[i].x), fmax(b.y, o->p[i].y), fmax(b.z, o->p[i].z));
+        }
+    } else if (o->shape == SHAPE_SPHERE) {
+        vec3 r = v3(o->radius, o->radius, o->radius);
+        a = v3_sub(o->p[0], r);
+        b = v3_add(o->p[0], r);
+    } else {
+        return 1;
+    }
+    return a.x <= hi.x && lo.x <= b.x && a.y <= hi.y && lo.y <= b.y && a.z <= hi.z && lo.z <= b.z;
+}
+
 /* Cuts the shadows of every part but the receiver and the light out of
  * the pieces.  Returns 0 when x is enclosed and sees nothing. */
 static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, vec3 x,
@@ -283,6 +309,14 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
 {
     const zt_scene *sc = c->scene;
     const object *lo = &sc->objects[sc->parts[light].object];
+    /* Only what meets the box around x and the light can cast a shadow. */
+    vec3 blo = x, bhi = x;
+    for (int k = 0; k < set->count; k++)
+        for (int i = 0; i < set->piece[k].n; i++) {
+            vec3 q = lift(f, set->piece[k].x[i], set->piece[k].y[i]);
+            blo = v3(fmin(blo.x, q.x), fmin(blo.y, q.y), fmin(blo.z, q.z));
+            bhi = v3(fmax(bhi.x, q.x), fmax(bhi.y, q.y), fmax(bhi.z, q.z));
+        }
     for (int i = 0; i < sc->part_count; i++) {
         if (i == receiver || i == light)
             continue;
@@ -295,15 +329,12 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
         if (oo->background && !lo->background)
             continue;
         int beyond = lo->background && !oo->background;
+        if (!beyond && !part_meets_box(o, blo, bhi))
+            continue;
         if (occlude_with(c, f, x, n, o, oo, beyond, set, scratch))
             return 0;
     }
     return 1;
-}
-
-static vec3 lift(const light_frame *f, double a, double b)
-{
-    return v3_add(f->origin, v3_add(v3_scale(f->u, a), v3_scale(f->v, b)));
 }
 
 double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
