@@ -14,50 +14,39 @@
 #include "zone/transfer.h"
 #include "zone/zone_internal.h"
 
-/* Bounds of the finite geometry and the camera, where planes need maps. */
-static void scene_bounds(const zt_scene *sc, vec3 *lo, vec3 *hi)
+static void box_add(vec3 *lo, vec3 *hi, vec3 q)
+{
+    *lo = v3(fmin(lo->x, q.x), fmin(lo->y, q.y), fmin(lo->z, q.z));
+    *hi = v3(fmax(hi->x, q.x), fmax(hi->y, q.y), fmax(hi->z, q.z));
+}
+
+void forest_scene_bounds(const zt_scene *sc, vec3 *lo, vec3 *hi)
 {
     *lo = v3(1e300, 1e300, 1e300);
     *hi = v3(-1e300, -1e300, -1e300);
-    vec3 pts[8];
-    int n;
     for (int i = 0; i < sc->part_count; i++) {
         const part *p = &sc->parts[i];
-        n = 0;
         if (p->shape == SHAPE_TRIANGLE) {
             for (int k = 0; k < 3; k++)
-                pts[n++] = p->p[k];
+                box_add(lo, hi, p->p[k]);
         } else if (p->shape == SHAPE_SPHERE) {
-            pts[n++] = v3_sub(p->p[0], v3(p->radius, p->radius, p->radius));
-            pts[n++] = v3_add(p->p[0], v3(p->radius, p->radius, p->radius));
+            box_add(lo, hi, v3_sub(p->p[0], v3(p->radius, p->radius, p->radius)));
+            box_add(lo, hi, v3_add(p->p[0], v3(p->radius, p->radius, p->radius)));
         } else if (p->shape == SHAPE_POINT) {
-            pts[n++] = p->p[0];
-        }
-        for (int k = 0; k < n; k++) {
-            *lo = v3(fmin(lo->x, pts[k].x), fmin(lo->y, pts[k].y), fmin(lo->z, pts[k].z));
-            *hi = v3(fmax(hi->x, pts[k].x), fmax(hi->y, pts[k].y), fmax(hi->z, pts[k].z));
+            box_add(lo, hi, p->p[0]);
         }
     }
-    const zt_camera *c = &sc->camera;
-    for (int k = 0; k < 5; k++) {
-        vec3 q = k < 4 ? v3_from(c->screen[k]) : v3_from(c->viewpoint);
-        *lo = v3(fmin(lo->x, q.x), fmin(lo->y, q.y), fmin(lo->z, q.z));
-        *hi = v3(fmax(hi->x, q.x), fmax(hi->y, q.y), fmax(hi->z, q.z));
-    }
+    int finite = lo->x <= hi->x;
+    vec3 centre = finite ? v3_scale(v3_add(*lo, *hi), 0.5) : v3(0, 0, 0);
+    double reach = finite ? 2.0 * v3_length(v3_sub(*hi, *lo)) + 1e-9 : 1e6;
     /* Rooms made of planes reach past the objects in them: add the corners
-     * where three planes meet, unless they lie absurdly far away. */
-    vec3 centre = v3_scale(v3_add(*lo, *hi), 0.5);
-    double reach = 4.0 * v3_length(v3_sub(*hi, *lo)) + 1e-9;
+     * where three planes meet, unless they lie far away. */
     vec3 add_lo = *lo, add_hi = *hi;
     for (int a = 0; a < sc->part_count; a++) {
         const part *pa = &sc->parts[a];
-        if (pa->shape != SHAPE_PLANE)
-            continue;
-        for (int b = a + 1; b < sc->part_count; b++) {
+        for (int b = a + 1; b < sc->part_count && pa->shape == SHAPE_PLANE; b++) {
             const part *pb = &sc->parts[b];
-            if (pb->shape != SHAPE_PLANE)
-                continue;
-            for (int k = b + 1; k < sc->part_count; k++) {
+            for (int k = b + 1; k < sc->part_count && pb->shape == SHAPE_PLANE; k++) {
                 const part *pc = &sc->parts[k];
                 if (pc->shape != SHAPE_PLANE)
                     continue;
@@ -70,15 +59,18 @@ static void scene_bounds(const zt_scene *sc, vec3 *lo, vec3 *hi)
                                                 v3_scale(v3_cross(pc->normal, pa->normal), pb->offset)),
                                          v3_scale(v3_cross(pa->normal, pb->normal), pc->offset)),
                                   1.0 / det);
-                if (v3_length(v3_sub(q, centre)) > reach)
-                    continue;
-                add_lo = v3(fmin(add_lo.x, q.x), fmin(add_lo.y, q.y), fmin(add_lo.z, q.z));
-                add_hi = v3(fmax(add_hi.x, q.x), fmax(add_hi.y, q.y), fmax(add_hi.z, q.z));
+                if (v3_length(v3_sub(q, centre)) <= reach)
+                    box_add(&add_lo, &add_hi, q);
             }
         }
     }
     *lo = add_lo;
     *hi = add_hi;
+    if (lo->x > hi->x) {
+        /* Nothing finite and no corners: a unit box at the origin. */
+        *lo = v3(-1, -1, -1);
+        *hi = v3(1, 1, 1);
+    }
 }
 
 static int clampi(double v, int lo, int hi)
@@ -87,7 +79,8 @@ static int clampi(double v, int lo, int hi)
     return i < lo ? lo : i > hi ? hi : i;
 }
 
-static void plane_layout(const part *p, vec3 lo, vec3 hi, double texel, map_layout *l)
+static void plane_layout(const part *p, vec3 lo, vec3 hi, double texel, int max_texels,
+                         map_layout *l)
 {
     vec3 n = p->normal;
     vec3 a = fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0);
@@ -102,18 +95,16 @@ static void plane_layout(const part *p, vec3 lo, vec3 hi, double texel, map_layo
         vmin = fmin(vmin, v3_dot(d, v));
         vmax = fmax(vmax, v3_dot(d, v));
     }
-    double mu = 0.1 * (umax - umin), mv = 0.1 * (vmax - vmin);
-    umin -= mu; umax += mu; vmin -= mv; vmax += mv;
     /* du x dv must point along the normal. */
     l->origin = v3_add(base, v3_add(v3_scale(u, umin), v3_scale(v, vmin)));
     l->du = v3_scale(u, umax - umin);
     l->dv = v3_scale(v, vmax - vmin);
-    l->nu = clampi((umax - umin) / texel, 2, 256);
-    l->nv = clampi((vmax - vmin) / texel, 2, 256);
+    l->nu = clampi((umax - umin) / texel, 2, max_texels);
+    l->nv = clampi((vmax - vmin) / texel, 2, max_texels);
 }
 
 static void layout_part(const zt_scene *sc, int i, vec3 lo, vec3 hi, double texel,
-                        map_layout *l)
+                        int max_texels, map_layout *l)
 {
     const part *p = &sc->parts[i];
     memset(l, 0, sizeof *l);
@@ -123,15 +114,15 @@ static void layout_part(const zt_scene *sc, int i, vec3 lo, vec3 hi, double texe
         l->origin = p->p[0];
         l->du = v3_sub(p->p[1], p->p[0]);
         l->dv = v3_sub(p->p[2], p->p[0]);
-        l->nu = clampi(v3_length(l->du) / texel, 2, 128);
-        l->nv = clampi(v3_length(l->dv) / texel, 2, 128);
+        l->nu = clampi(v3_length(l->du) / texel, 2, max_texels);
+        l->nv = clampi(v3_length(l->dv) / texel, 2, max_texels);
     } else if (p->shape == SHAPE_SPHERE) {
         l->centre = p->p[0];
         l->radius = p->radius;
-        l->nv = clampi(3.14159265358979 * p->radius / texel, 4, 96);
+        l->nv = clampi(3.14159265358979 * p->radius / texel, 4, max_texels);
         l->nu = 2 * l->nv;
     } else {
-        plane_layout(p, lo, hi, texel, l);
+        plane_layout(p, lo, hi, texel, max_texels, l);
     }
 }
 
@@ -265,13 +256,18 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
     if (f->map_levels == 0)
         return ZT_OK;
     vec3 lo, hi;
-    scene_bounds(sc, &lo, &hi);
+    forest_scene_bounds(sc, &lo, &hi);
+    /* Planes are mapped well beyond the scene's core: open rooms (the
+     * Cornell box has no front wall) send light out that comes back. */
+    vec3 margin = v3_sub(hi, lo);
+    lo = v3_sub(lo, margin);
+    hi = v3_add(hi, margin);
     for (int i = 0; i < sc->part_count; i++) {
         const object *o = &sc->objects[sc->parts[i].object];
         if (o->is_light || o->mat.weight[LOBE_DIFFUSE] <= 0)
             continue;
         part_map *m = &f->maps[i];
-        layout_part(sc, i, lo, hi, f->q.texel, &m->layout);
+        layout_part(sc, i, lo, hi, f->q.texel, f->q.max_texels, &m->layout);
         m->levels = f->map_levels;
         size_t n = (size_t)m->levels * (size_t)m->layout.sides * (size_t)m->layout.nu *
                    (size_t)m->layout.nv * 3;

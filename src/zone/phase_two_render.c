@@ -77,7 +77,7 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
     progress prog;
     progress_init(&prog, o, "zone", (double)sum->height);
     uint64_t rays = 0;
-    int failed = 0;
+    volatile int failed = 0; /* set by any thread that runs out of memory */
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
         zone_trace t = {c->f, c->r, 0, 0.0f};
@@ -124,7 +124,7 @@ zt_status p2_render_reference(const p2_ctx *c, zt_image *sum, uint64_t *rays_out
     const zt_render_options *o = &c->r->options;
     int threads = render_thread_count(o->threads);
     uint64_t rays = 0;
-    int failed = 0;
+    volatile int failed = 0; /* set by any thread that runs out of memory */
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
         zone_trace t = {c->f, c->r, 0, 0.0f};
@@ -164,7 +164,7 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
     size_t npix = (size_t)w * (size_t)h;
     zt_status st = ZT_OK;
     uint64_t rays = 0;
-    int failed = 0;
+    volatile int failed = 0; /* set by any thread that runs out of memory */
 
     /* 1. The sample lists of the whole image. */
     p2_row *rows = calloc((size_t)h, sizeof *rows);
@@ -271,7 +271,8 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
                                       : hit_first[q + 1] - hit_first[q];
         if (n == 0)
             continue;
-#pragma omp parallel num_threads(threads) reduction(+ : rays)
+        /* Small terms stay on this thread: waking the others costs more. */
+#pragma omp parallel num_threads(threads) reduction(+ : rays) if (n >= 256)
         {
             zone_trace t = {c->f, c->r, 0, 0.0f};
             int done = 0;

@@ -41,6 +41,7 @@ typedef struct zone_quality {
     int aa;             /* sub-pixel grid per side */
     double texel_divisor; /* texel = scene extent / texel_divisor */
     double theta;       /* transfer: pieces are split above this size/distance */
+    int max_texels;     /* at most this many texels along a map's side */
 } zone_quality;
 
 typedef struct zone_forest {
@@ -70,6 +71,10 @@ zone_quality zone_quality_for(const zt_scene *sc, int q);
 /* Phase One pieces. */
 zt_status forest_build_tree(zone_forest *f, const zt_renderer *r, zt_error *err);
 zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err);
+
+/* The scene's core: the box of the finite parts and of the corners where
+ * three planes meet; independent of the camera. */
+void forest_scene_bounds(const zt_scene *sc, vec3 *lo, vec3 *hi);
 void forest_free(zone_forest *f);
 
 /* Radiance arriving along a ray with levels lo..hi (flags below). */

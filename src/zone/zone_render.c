@@ -11,32 +11,21 @@
 
 zone_quality zone_quality_for(const zt_scene *sc, int q)
 {
-    /* The scene's size sets the texel size; each quality step halves it
-     * (in area) and doubles the gather directions. */
-    double extent = 0;
-    for (int i = 0; i < sc->part_count; i++) {
-        const part *p = &sc->parts[i];
-        for (int k = 0; k < 3 && p->shape == SHAPE_TRIANGLE; k++)
-            extent = fmax(extent, v3_length(v3_sub(p->p[k], p->p[(k + 1) % 3])));
-        if (p->shape == SHAPE_SPHERE)
-            extent = fmax(extent, 2 * p->radius);
-    }
-    extent = fmax(extent, v3_length(v3_sub(v3_from(sc->camera.screen[1]), v3_from(sc->camera.screen[0]))));
+    /* The scene's size (not the camera's: the forest must not depend on
+     * it) sets the texel size; each quality step halves the texel area,
+     * doubles the gather directions and refines the transfer. */
+    vec3 lo, hi;
+    forest_scene_bounds(sc, &lo, &hi);
+    double extent = v3_length(v3_sub(hi, lo));
+    double step = pow(sqrt(2.0), q);
     zone_quality z;
     z.gather = 32 << q;
-    z.texel_divisor = 12.0 * pow(sqrt(2.0), q);
+    z.texel_divisor = 20.0 * step;
     z.texel = extent / z.texel_divisor;
+    z.max_texels = (int)(48.0 * step); /* planes are mapped 3x the core */
     z.sides = 16 << (q / 2);
     z.aa = q < 2 ? 1 : 2;
-    z.theta = 0.5 / pow(sqrt(2.0), q);
-    if (getenv("ZT_ZONE_GATHER"))
-        z.gather = atoi(getenv("ZT_ZONE_GATHER"));
-    if (getenv("ZT_ZONE_THETA"))
-        z.theta = atof(getenv("ZT_ZONE_THETA"));
-    if (getenv("ZT_ZONE_TEXEL")) {
-        z.texel_divisor = atof(getenv("ZT_ZONE_TEXEL"));
-        z.texel = extent / z.texel_divisor;
-    }
+    z.theta = 0.5 / step;
     return z;
 }
 
@@ -121,14 +110,16 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
     p2_terms_free(&c.terms);
     if (stats) {
         stats->threads = render_thread_count(o->threads);
-        stats->rays = rays + (f->images == 0 ? f->rays : 0);
+        /* Phase One's rays are charged to the first image, unless the
+         * forest was read from a file. */
+        stats->rays = rays + (f->images == 0 && !f->loaded ? f->rays : 0);
         stats->samples = (uint64_t)sum->width * sum->height * (uint64_t)(c.g * c.g);
         /* Phase One is charged to the first image of the renderer only. */
         stats->phase_one_seconds = f->images == 0 ? f->phase_one_seconds : 0.0;
         stats->phase_two_seconds = render_clock() - t0;
         fill_forest_stats(f, stats);
     }
-    if (st == ZT_OK)
+    if (st == ZT_OK && !reference)
         f->images++;
     return st;
 }
