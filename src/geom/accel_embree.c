@@ -5,7 +5,7 @@
 #include "geom/accel_internal.h"
 
 #include <embree3/rtcore.h>
-#include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -91,7 +91,12 @@ static int embree_any(const accel *a, int layer, vec3f o, vec3f d, float tmax)
     r.org_x = o.x; r.org_y = o.y; r.org_z = o.z;
     r.dir_x = d.x; r.dir_y = d.y; r.dir_z = d.z;
     r.tnear = 0.0f;
-    r.tfar = nextafterf(tmax, 0.0f); /* Embree includes tfar; the contract excludes it */
+    /* Embree includes tfar; the contract excludes it: one float below. */
+    uint32_t bits;
+    memcpy(&bits, &tmax, sizeof bits);
+    if (tmax > 0.0f && bits < 0x7f800000u)
+        bits--;
+    memcpy(&r.tfar, &bits, sizeof bits);
     r.time = 0.0f;
     r.mask = 0xffffffffu;
     r.id = 0;
