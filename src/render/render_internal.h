@@ -48,9 +48,10 @@ zt_status zone_accumulate(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
                           zt_error *err);
 void zone_release(zt_renderer *r);
 
-/* The acceleration structure renderers use: Embree unless ZT_ACCEL in the
- * environment says "bvh" (our own) or "brute" (the oracle), for tests and
- * benchmarks. */
-int render_accel_kind(void);
+/* The acceleration structure for a scene of that many primitives: our BVH
+ * for small scenes, Embree for large ones, unless ZT_ACCEL in the
+ * environment says "embree", "bvh" or "brute" (for tests and benchmarks). */
+#define ACCEL_SMALL_SCENE 1000
+int render_accel_kind(int primitives);
 
 #endif

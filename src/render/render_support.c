@@ -20,14 +20,19 @@ int render_thread_count(int requested)
     return requested > 0 ? requested : omp_get_num_procs();
 }
 
-int render_accel_kind(void)
+int render_accel_kind(int primitives)
 {
     const char *e = getenv("ZT_ACCEL");
     if (e && strcmp(e, "brute") == 0)
         return ACCEL_BRUTE;
     if (e && strcmp(e, "bvh") == 0)
         return ACCEL_BVH;
-    return ACCEL_EMBREE;
+    if (e && strcmp(e, "embree") == 0)
+        return ACCEL_EMBREE;
+    /* Measured (BENCHMARKS.md): our binary BVH matches or beats Embree on
+     * scenes of tens of primitives (no per-call overhead, cheaper spheres),
+     * Embree's wide SIMD trees win by 2-3x from thousands on. */
+    return primitives <= ACCEL_SMALL_SCENE ? ACCEL_BVH : ACCEL_EMBREE;
 }
 
 void progress_init(progress *p, const zt_render_options *o, const char *stage,
