@@ -17,6 +17,7 @@
 #include "scene/scene_reader.h"
 #include "scene/source_map.h"
 #include "util/error.h"
+#include "util/read_file.h"
 
 /* No scene needs more; a bigger file is taken for a mistake. */
 #define MAX_SCENE_BYTES ((size_t)64 << 20)
@@ -152,71 +153,15 @@ zt_status zt_scene_load_string(const char *text, size_t length,
     return ZT_OK;
 }
 
-/* Reads at most MAX_SCENE_BYTES + 1 bytes, so that a too large file that
- * is not a regular file (a pipe) is noticed without reading all of it. */
-static zt_status read_all(FILE *f, const char *path, char **text,
-                          size_t *length, zt_error *err)
-{
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    if (!buf)
-        return zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", path);
-    for (;;) {
-        if (n == cap) {
-            size_t limit = MAX_SCENE_BYTES + 1;
-            cap = cap * 2 < limit ? cap * 2 : limit;
-            char *p = n < cap ? realloc(buf, cap) : NULL;
-            if (!p) {
-                free(buf);
-                if (n > MAX_SCENE_BYTES)
-                    return zt_fail(err, ZT_ERR_READ, "%s: too large (the limit "
-                                   "is 64 MiB)", path);
-                return zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", path);
-            }
-            buf = p;
-        }
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    if (ferror(f)) {
-        int e = errno;
-        free(buf);
-        return zt_fail(err, ZT_ERR_READ, "%s: cannot read: %s", path, strerror(e));
-    }
-    if (n > MAX_SCENE_BYTES) {
-        free(buf);
-        return zt_fail(err, ZT_ERR_READ, "%s: too large (the limit is 64 MiB)", path);
-    }
-    *text = buf;
-    *length = n;
-    return ZT_OK;
-}
-
 zt_status zt_scene_load_file(const char *path, zt_scene **out, zt_error *err)
 {
     zt_error_clear(err);
     if (!path || !out)
         return zt_fail(err, ZT_ERR_ARGUMENT, "zt_scene_load_file: no path or no result pointer");
     *out = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return zt_fail(err, ZT_ERR_READ, "%s: cannot open: %s", path, strerror(errno));
-    struct stat st;
-    zt_status status = ZT_OK;
-    if (fstat(fileno(f), &st) != 0)
-        status = zt_fail(err, ZT_ERR_READ, "%s: cannot read: %s", path, strerror(errno));
-    else if (S_ISDIR(st.st_mode))
-        status = zt_fail(err, ZT_ERR_READ, "%s: is a directory, not a scene file", path);
-    else if (S_ISREG(st.st_mode) && (unsigned long long)st.st_size > MAX_SCENE_BYTES)
-        status = zt_fail(err, ZT_ERR_READ, "%s: too large: %lld bytes (the limit "
-                         "is 64 MiB)", path, (long long)st.st_size);
     char *text = NULL;
     size_t length = 0;
-    if (!status)
-        status = read_all(f, path, &text, &length, err);
-    fclose(f);
+    zt_status status = read_text_file(path, "scene file", MAX_SCENE_BYTES, &text, &length, err);
     if (!status)
         status = zt_scene_load_string(text, length, path, out, err);
     free(text);

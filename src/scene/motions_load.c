@@ -17,6 +17,7 @@
 #include "scene/motions.h"
 #include "scene/source_map.h"
 #include "util/error.h"
+#include "util/read_file.h"
 
 /* A motions file is a few hundred bytes; anything this large is a mistake. */
 #define MAX_MOTIONS_BYTES ((size_t)16 << 20)
@@ -335,49 +336,9 @@ zt_status zt_motions_load_file(const char *path, zt_motions **out, zt_error *err
     if (!path || !out)
         return zt_fail(err, ZT_ERR_ARGUMENT, "zt_motions_load_file: no path or no result pointer");
     *out = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return zt_fail(err, ZT_ERR_READ, "%s: cannot open: %s", path, strerror(errno));
-    struct stat st;
-    zt_status status = ZT_OK;
-    if (fstat(fileno(f), &st) != 0)
-        status = zt_fail(err, ZT_ERR_READ, "%s: cannot read: %s", path, strerror(errno));
-    else if (S_ISDIR(st.st_mode))
-        status = zt_fail(err, ZT_ERR_READ, "%s: is a directory, not a motions file", path);
     char *text = NULL;
     size_t n = 0;
-    if (!status) {
-        /* at most MAX_MOTIONS_BYTES + 1 bytes, so a pipe cannot run away */
-        size_t cap = MAX_MOTIONS_BYTES + 1;
-        size_t chunk = 1 << 16, size = chunk;
-        text = malloc(size);
-        if (!text)
-            status = zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", path);
-        while (!status) {
-            if (n == size) {
-                size_t bigger = size * 2 < cap ? size * 2 : cap;
-                char *p = bigger > size ? realloc(text, bigger) : NULL;
-                if (!p) {
-                    status = bigger > size
-                                 ? zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", path)
-                                 : zt_fail(err, ZT_ERR_READ, "%s: too large (the limit "
-                                           "is 16 MiB)", path);
-                    break;
-                }
-                text = p;
-                size = bigger;
-            }
-            size_t got = fread(text + n, 1, size - n, f);
-            n += got;
-            if (got == 0)
-                break;
-        }
-        if (!status && ferror(f))
-            status = zt_fail(err, ZT_ERR_READ, "%s: cannot read: %s", path, strerror(errno));
-        if (!status && n > MAX_MOTIONS_BYTES)
-            status = zt_fail(err, ZT_ERR_READ, "%s: too large (the limit is 16 MiB)", path);
-    }
-    fclose(f);
+    zt_status status = read_text_file(path, "motions file", MAX_MOTIONS_BYTES, &text, &n, err);
     if (!status)
         status = zt_motions_load_string(text, n, path, out, err);
     free(text);
