@@ -523,11 +523,12 @@ static zt_status check_options(const char *path, const forest_options *file,
     return zt_fail(err, ZT_ERR_PARSE, "%s%s", full, msg);
 }
 
-static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, const char *path,
+static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const char *path,
                            zt_error *err)
 {
     int oom = 0;
     f->map_levels = r_i32(rb);
+    f->sky_slot = sky ? f->map_levels : -1; /* as forest_build_maps decides */
     int map_count = r_i32(rb);
     if (rb->short_read)
         return ZT_ERR_PARSE;
@@ -561,7 +562,7 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, const char *path
             return ZT_ERR_PARSE;
         if (l->shape < SHAPE_SPHERE || l->shape > SHAPE_POINT || l->nu < 1 ||
             l->nu > MAP_DIM_MAX || l->nv < 1 || l->nv > MAP_DIM_MAX || l->sides < 1 ||
-            l->sides > 2 || m->levels != f->map_levels || m->levels < 1)
+            l->sides > 2 || m->levels != f->map_levels + (f->sky_slot >= 0) || m->levels < 1)
             return corrupt(err, path, "bad map layout");
         m->texels = r_f32s(rb, mip_values(m, 0), &oom);
         if (m->texels)
@@ -763,7 +764,7 @@ zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *
         st = ZT_ERR_PARSE;
         goto done;
     }
-    st = read_maps(f, &rb, parts, path, err);
+    st = read_maps(f, &rb, parts, !f3_is_black(r->rs.sky), path, err);
     if (st == ZT_OK && !rb.short_read && rb.at != n - 8)
         st = corrupt(err, path, "unexpected data after the maps");
 done:

@@ -242,6 +242,24 @@ static float texel_weight(const rscene *rs, int own, vec3 x, vec3 n, const vec3 
     return 2 * inside >= count ? 0.0f : 1.0f;
 }
 
+/* The sky's share of E_0: cosine-distributed directions that escape. */
+static vec3 sky_texel(zone_trace *t, const zone_forest *f, vec3 x, vec3 n, const vec3 *dirs)
+{
+    const rscene *rs = &t->r->rs;
+    vec3 tt, bb;
+    frame(n, &tt, &bb);
+    vec3f o = ray_offset(to_f(x), to_f(n));
+    int open = 0;
+    for (int k = 0; k < f->q.gather; k++) {
+        vec3 d = v3_add(v3_add(v3_scale(tt, dirs[k].x), v3_scale(bb, dirs[k].y)),
+                        v3_scale(n, dirs[k].z));
+        hit h = accel_intersect(rs, o, to_f(d));
+        t->rays++;
+        open += h.part < 0;
+    }
+    return v3_scale(v3(rs->sky.x, rs->sky.y, rs->sky.z), 3.14159265358979 * open / f->q.gather);
+}
+
 zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
 {
     const zt_scene *sc = r->scene;
@@ -253,7 +271,10 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
     if (!f->maps)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
     f->map_count = sc->part_count;
-    if (f->map_levels == 0)
+    /* The sky's direct light has no closed form: it gets a level of its
+     * own, gathered, which the camera's level 1 reads. */
+    f->sky_slot = f3_is_black(r->rs.sky) ? -1 : f->map_levels;
+    if (f->map_levels == 0 && f->sky_slot < 0)
         return ZT_OK;
     vec3 lo, hi;
     forest_scene_bounds(sc, &lo, &hi);
@@ -268,7 +289,7 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
             continue;
         part_map *m = &f->maps[i];
         layout_part(sc, i, lo, hi, f->q.texel, f->q.max_texels, &m->layout);
-        m->levels = f->map_levels;
+        m->levels = f->map_levels + (f->sky_slot >= 0);
         size_t n = (size_t)m->levels * (size_t)m->layout.sides * (size_t)m->layout.nu *
                    (size_t)m->layout.nv * 3;
         m->texels = calloc(n, sizeof(float));
@@ -310,7 +331,8 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
     }
     int threads = render_thread_count(r->options.threads);
     uint64_t rays = 0;
-    for (int level = 0; level < f->map_levels; level++) {
+    int last = f->sky_slot >= 0 ? f->sky_slot : f->map_levels - 1;
+    for (int level = 0; level <= last; level++) {
         /* One work item per texel row of every map and side. */
         for (int i = 0; i < sc->part_count; i++) {
             part_map *m = &f->maps[i];
@@ -326,7 +348,8 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                     map_texel_point(&m->layout, u, j, &x, &n);
                     if (side)
                         n = v3_scale(n, -1);
-                    vec3 e = texel_value(&t, f, i, level, x, n, dirs);
+                    vec3 e = level == f->sky_slot ? sky_texel(&t, f, x, n, dirs)
+                                                  : texel_value(&t, f, i, level, x, n, dirs);
                     float *px = map_texel(m, level, side, u, j);
                     px[0] = (float)e.x;
                     px[1] = (float)e.y;

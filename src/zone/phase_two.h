@@ -75,7 +75,8 @@ typedef enum p2_term_type {
     P2_SKY,         /* level 0: the sky on samples that hit nothing */
     P2_DIRECT,      /* level 1 diffuse from one light part */
     P2_MAP,         /* level >= 2 diffuse from the receiver's map */
-    P2_SPECULAR     /* a specular lobe at level >= 1 */
+    P2_SPECULAR,    /* a specular lobe at level >= 1 */
+    P2_SKY_DIRECT   /* level 1 diffuse from the sky (its map level) */
 } p2_term_type;
 
 typedef struct p2_term {

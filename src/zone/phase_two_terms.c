@@ -107,9 +107,12 @@ zt_status p2_terms_build(p2_terms *t, const zone_forest *f, const zt_renderer *r
                         continue;
                     p2_term term = {P2_SPECULAR, -1, q, -1, kind, l};
                     if (kind == ZONE_DIFFUSE) {
-                        if (l == 1 || l - 1 >= f->map_levels)
+                        if (l == 1)
+                            term.type = P2_SKY_DIRECT;
+                        else if (l - 1 < f->map_levels)
+                            term.type = P2_MAP;
+                        else
                             continue;
-                        term.type = P2_MAP;
                     }
                     ok = push_term(t, &cap, term);
                 }
@@ -187,7 +190,8 @@ static vec3 map_value(zone_trace *t, const p2_term *term, const p2_sample *s)
 {
     surface sf;
     surface_of(&t->r->rs, s, &sf);
-    vec3 e = map_lookup_wide(&t->f->maps[s->part], term->level - 1, sf.back, sf.x, 0.0);
+    int slot = term->type == P2_SKY_DIRECT ? t->f->sky_slot : term->level - 1;
+    vec3 e = map_lookup_wide(&t->f->maps[s->part], slot, sf.back, sf.x, 0.0);
     return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
 }
 
@@ -289,7 +293,7 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
         if (s->part != term->part)
             continue;
         vec3 v = term->type == P2_DIRECT ? direct_value(t, term, s)
-                 : term->type == P2_MAP  ? map_value(t, term, s)
+                 : term->type == P2_MAP || term->type == P2_SKY_DIRECT ? map_value(t, term, s)
                                          : specular_value(t, term, s);
         add(acc, s->w, v);
     }

@@ -53,6 +53,8 @@ typedef struct zone_forest {
     part_map *maps;     /* per part (only diffuse things have texels) */
     int map_count;
     int map_levels;     /* irradiance levels E_0 .. E_{map_levels-1} */
+    int sky_slot;       /* map level holding the sky's direct irradiance
+                           (map_levels), or -1 under a black sky */
     direct_ctx direct;
     zone_quality q;
     int need_gather;    /* some light arrives by specular surfaces or spheres */
