@@ -174,13 +174,35 @@ static void sphere_cut(const direct_ctx *c, const light_frame *f, vec3 x, const 
 
 /* Cuts the shadow of part `o` (seen from x) out of the light's pieces.
  * Returns 1 when x is wholly enclosed (inside an opaque sphere). */
+/* The pyramid from x through the light's polygon: a triangle wholly
+ * outside one of its side planes casts no shadow on the light. */
+#define FRUSTUM_MAX 16
+typedef struct frustum {
+    int n;                   /* 0: no test */
+    vec3 normal[FRUSTUM_MAX];/* inward normals of the planes through x */
+} frustum;
+
+static int outside_frustum(const frustum *fr, vec3 x, const vec3 *p, int count)
+{
+    for (int k = 0; k < fr->n; k++) {
+        int out = 1;
+        for (int i = 0; i < count && out; i++)
+            out = v3_dot(fr->normal[k], v3_sub(p[i], x)) < 0;
+        if (out)
+            return 1;
+    }
+    return 0;
+}
+
 static int occlude_with(const direct_ctx *c, const light_frame *f, vec3 x,
                         vec3 n, const part *o, const object *oo, int beyond,
-                        poly2_set *set, poly2 *scratch)
+                        const frustum *fr, poly2_set *set, poly2 *scratch)
 {
     poly3 poly;
     switch (o->shape) {
     case SHAPE_TRIANGLE: {
+        if (outside_frustum(fr, x, o->p, 3))
+            return 0;
         vec3 nt = v3_cross(v3_sub(o->p[1], o->p[0]), v3_sub(o->p[2], o->p[0]));
         /* A culled triangle lets rays from behind through. */
         if (oo->backculled && v3_dot(nt, v3_sub(x, o->p[0])) <= 0)
@@ -289,8 +311,8 @@ static int part_meets_box(const part *o, vec3 lo, vec3 hi)
     if (o->shape == SHAPE_TRIANGLE) {
         a = b = o->p[0];
         for (int i = 1; i < 3; i++) {
-            a = v3(fmin(a.x, o->p[i].x), fmin(a.y, o->p[i].y), fmin(a.z, o->p[i].z));
-            b = v3(fmax(b.x, o->p[i].x), fmax(b.y, o->p[i].y), fmax(b.z, o->p[i].z));
+            a = v3_min3(a, o->p[i]);
+            b = v3_max3(b, o->p[i]);
         }
     } else if (o->shape == SHAPE_SPHERE) {
         vec3 r = v3(o->radius, o->radius, o->radius);
@@ -314,9 +336,28 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
     for (int k = 0; k < set->count; k++)
         for (int i = 0; i < set->piece[k].n; i++) {
             vec3 q = lift(f, set->piece[k].x[i], set->piece[k].y[i]);
-            blo = v3(fmin(blo.x, q.x), fmin(blo.y, q.y), fmin(blo.z, q.z));
-            bhi = v3(fmax(bhi.x, q.x), fmax(bhi.y, q.y), fmax(bhi.z, q.z));
+            blo = v3_min3(blo, q);
+            bhi = v3_max3(bhi, q);
         }
+    /* Side planes of the pyramid from x through the (one, convex) light
+     * polygon, facing inward; background lights are blocked beyond it
+     * too, which the pyramid does not bound, so they skip the test. */
+    frustum fr = {0, {{0, 0, 0}}};
+    const poly2 *lp = &set->piece[0];
+    if (set->count == 1 && lp->n >= 3 && lp->n <= FRUSTUM_MAX && !lo->background) {
+        vec3 q0 = lift(f, lp->x[lp->n - 1], lp->y[lp->n - 1]), inside = v3(0, 0, 0);
+        for (int i = 0; i < lp->n; i++)
+            inside = v3_add(inside, lift(f, lp->x[i], lp->y[i]));
+        inside = v3_scale(inside, 1.0 / lp->n);
+        for (int i = 0; i < lp->n; i++) {
+            vec3 q1 = lift(f, lp->x[i], lp->y[i]);
+            vec3 nn = v3_cross(v3_sub(q0, x), v3_sub(q1, x));
+            if (v3_dot(nn, v3_sub(inside, x)) < 0)
+                nn = v3_scale(nn, -1);
+            fr.normal[fr.n++] = nn;
+            q0 = q1;
+        }
+    }
     for (int i = 0; i < sc->part_count; i++) {
         if (i == receiver || i == light)
             continue;
@@ -331,7 +372,7 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
         int beyond = lo->background && !oo->background;
         if (!beyond && !part_meets_box(o, blo, bhi))
             continue;
-        if (occlude_with(c, f, x, n, o, oo, beyond, set, scratch))
+        if (occlude_with(c, f, x, n, o, oo, beyond, &fr, set, scratch))
             return 0;
     }
     return 1;
