@@ -55,7 +55,45 @@ typedef struct wstate {
     double ev_time;
     int ev_stale;
     int ev_spp;            /* samples per pixel when it was computed */
+    int zone_preview;      /* zone: next frame at half resolution (moving) */
+    zt_image *small;       /* the half-resolution frame */
 } wstate;
+
+/* Zone mode while the camera moves: Phase Two at half the resolution,
+ * shown enlarged, then the full frame once the camera rests.  Returns the
+ * status of the render. */
+static zt_status zone_preview_frame(wstate *s, zt_render_stats *stats, zt_error *err)
+{
+    int w = s->sum->width, h = s->sum->height;
+    int sw = w > 1 ? w / 2 : 1, sh = h > 1 ? h / 2 : 1;
+    if (!s->small || s->small->width != sw || s->small->height != sh) {
+        zt_image_release(s->small);
+        s->small = zt_image_create(sw, sh);
+        if (!s->small)
+            return ZT_ERR_MEMORY;
+    }
+    zt_camera cam = s->req.camera;
+    zt_status st = zt_camera_set_resolution(&cam, sw, sh, err);
+    if (st == ZT_OK)
+        st = zt_renderer_set_camera(s->r, &cam, err);
+    if (st != ZT_OK)
+        return st;
+    memset(s->small->pixels, 0, (size_t)sw * sh * 3 * sizeof(float));
+    st = zt_renderer_accumulate(s->r, 0, 1, s->small, stats, err);
+    zt_error ignored;
+    zt_renderer_set_camera(s->r, &s->req.camera, &ignored);
+    if (st != ZT_OK)
+        return st;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float *src = zt_image_pixel(s->small, x * sw / w, y * sh / h);
+            float *dst = zt_image_pixel(s->sum, x, y);
+            dst[0] = src[0];
+            dst[1] = src[1];
+            dst[2] = src[2];
+        }
+    return ZT_OK;
+}
 
 static int ilog2(int x)
 {
@@ -303,6 +341,7 @@ static void *worker_main(void *arg)
             s.cam_epoch = cam_epoch;
             s.req.camera = req.camera;
             st = zt_renderer_set_camera(s.r, &req.camera, &err);
+            s.zone_preview = s.method == ZT_METHOD_ZONE;
         }
         if (opt_changed || moved || cam_changed || st != ZT_OK) {
             s.spp = 0;
@@ -324,6 +363,22 @@ static void *worker_main(void *arg)
         zt_render_stats stats;
         memset(&stats, 0, sizeof stats);
         double t0 = view_now();
+        if (s.method == ZT_METHOD_ZONE && s.zone_preview) {
+            s.zone_preview = 0;
+            st = zone_preview_frame(&s, &stats, &err);
+            if (st == ZT_OK) {
+                /* Shown as 0 samples: screenshots wait for the full frame. */
+                s.rays += stats.rays;
+                s.first_batch = 0;
+                publish(&s, view_now() - t0);
+                pthread_mutex_lock(&sh->lock);
+                continue;
+            }
+            if (st == ZT_ERR_CANCELLED) {
+                pthread_mutex_lock(&sh->lock);
+                continue;
+            }
+        }
         if (s.method == ZT_METHOD_ZONE)
             memset(s.sum->pixels, 0, (size_t)s.sum->width * (size_t)s.sum->height * 3 * sizeof(float));
         st = zt_renderer_accumulate(s.r, s.spp, 1, s.sum, &stats, &err);
@@ -369,6 +424,7 @@ static void *worker_main(void *arg)
     zt_renderer_release(s.r);
     zt_scene_release(s.scene);
     zt_image_release(s.sum);
+    zt_image_release(s.small);
     return NULL;
 }
 
