@@ -348,8 +348,12 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                     map_texel_point(&m->layout, u, j, &x, &n);
                     if (side)
                         n = v3_scale(n, -1);
-                    vec3 e = level == f->sky_slot ? sky_texel(&t, f, x, n, dirs)
-                                                  : texel_value(&t, f, i, level, x, n, dirs);
+                    /* Texels off the reachable surface (outside the room,
+                     * inside objects) are never read: no need to light them. */
+                    int reachable = m->weight[0][((size_t)side * m->layout.nv + j) * m->layout.nu + u] > 0;
+                    vec3 e = !reachable             ? v3(0, 0, 0)
+                             : level == f->sky_slot ? sky_texel(&t, f, x, n, dirs)
+                                                    : texel_value(&t, f, i, level, x, n, dirs);
                     float *px = map_texel(m, level, side, u, j);
                     px[0] = (float)e.x;
                     px[1] = (float)e.y;
