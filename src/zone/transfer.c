@@ -100,9 +100,10 @@ static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, 
     const map_layout *l = &src->m->layout;
     double s0 = (double)i0 / l->nu, s1 = (double)i1 / l->nu;
     double t0 = (double)j0 / l->nv, t1 = (double)j1 / l->nv;
-    vec3 q[PIECE_MAX] = {param_point(l, s0, t0), param_point(l, s1, t0), param_point(l, s1, t1),
-                         param_point(l, s0, t1)};
-    vec3 centre = param_point(l, 0.5 * (s0 + s1), 0.5 * (t0 + t1));
+    vec3 q[PIECE_MAX]; /* not zeroed: this runs for every piece */
+    q[0] = param_point(l, s0, t0);
+    q[2] = param_point(l, s1, t1);
+    vec3 centre = v3_scale(v3_add(q[0], q[2]), 0.5);
     double size = v3_length(v3_sub(q[2], q[0]));
     double dist = v3_length(v3_sub(centre, r->x));
     if (size > r->theta * dist && (i1 - i0 > 1 || j1 - j0 > 1)) {
@@ -118,6 +119,8 @@ static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, 
         }
         return e;
     }
+    q[1] = param_point(l, s1, t0);
+    q[3] = param_point(l, s0, t1);
     int n = 4;
     /* A triangle's map covers the parallelogram around it: keep s + t <= 1. */
     if (src->is_triangle) {
