@@ -15,5 +15,6 @@ typedef struct accel {
 
 zt_status accel_build_embree(rscene *rs, zt_error *err);
 zt_status accel_build_brute(rscene *rs, zt_error *err);
+zt_status accel_build_bvh(rscene *rs, zt_error *err);
 
 #endif

@@ -92,7 +92,6 @@ void accel_free(struct accel *a)
         a->destroy(a);
 }
 
-zt_status accel_build_bvh(rscene *rs, zt_error *err); /* accel_bvh.c */
 
 zt_status accel_build(rscene *rs, accel_kind kind, zt_error *err)
 {

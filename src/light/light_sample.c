@@ -34,6 +34,19 @@ static float cone_one_minus_cos(float r, float dc)
     return 1.0f - sqrtf(fmaxf(0.0f, 1.0f - s2));
 }
 
+/* Points the sample from x at the light point y; returns the squared
+ * distance (0 when y is x). */
+static float aim_at(vec3f x, vec3f y, light_sample *out)
+{
+    vec3f v = f3_sub(y, x);
+    float d2 = f3_dot(v, v), d = sqrtf(d2);
+    if (d <= 0.0f)
+        return 0.0f;
+    out->wi = f3_scale(v, 1.0f / d);
+    out->dist = d;
+    return d2;
+}
+
 static int sample_sphere(const rs_part *p, vec3f x, const float u2[2],
                          light_sample *out)
 {
@@ -45,13 +58,9 @@ static int sample_sphere(const rs_part *p, vec3f x, const float u2[2],
         float z = 1.0f - 2.0f * u2[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
         float phi = 2.0f * ZT_PI * u2[1];
         vec3f nrm = f3(r * cosf(phi), r * sinf(phi), z);
-        vec3f y = f3_madd(p->p0, nrm, p->radius);
-        vec3f v = f3_sub(y, x);
-        float d2 = f3_dot(v, v), d = sqrtf(d2);
-        if (d <= 0.0f)
+        float d2 = aim_at(x, f3_madd(p->p0, nrm, p->radius), out);
+        if (d2 <= 0.0f)
             return 0;
-        out->wi = f3_scale(v, 1.0f / d);
-        out->dist = d;
         float c = fabsf(f3_dot(nrm, out->wi));
         if (c <= 0.0f)
             return 0;
@@ -82,12 +91,9 @@ static int sample_triangle(const rs_part *p, vec3f x, const float u2[2],
     float su = sqrtf(u2[0]);
     float b1 = su * (1.0f - u2[1]), b2 = su * u2[1];
     vec3f y = f3_add(p->p0, f3_add(f3_scale(p->e1, b1), f3_scale(p->e2, b2)));
-    vec3f v = f3_sub(y, x);
-    float d2 = f3_dot(v, v), d = sqrtf(d2);
-    if (d <= 0.0f)
+    float d2 = aim_at(x, y, out);
+    if (d2 <= 0.0f)
         return 0;
-    out->wi = f3_scale(v, 1.0f / d);
-    out->dist = d;
     float c = f3_dot(p->n, out->wi); /* > 0: x sees the back */
     if (c == 0.0f || (p->culled && c > 0.0f))
         return 0;

@@ -88,11 +88,6 @@ static vec3 bilinear(const part_map *m, int k, int level, int side, double s, do
     return sw > 1e-6 ? v3_scale(r, 1.0 / sw) : plain;
 }
 
-vec3 map_lookup(const part_map *m, int level, int side, vec3 p)
-{
-    return map_lookup_wide(m, level, side, p, 0.0);
-}
-
 vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double width)
 {
     const map_layout *l = &m->layout;

@@ -45,15 +45,12 @@ void map_texel_point(const map_layout *l, int i, int j, vec3 *p, vec3 *n);
 /* Where point p (on the part) falls on the grid, in texel units. */
 void map_coords(const map_layout *l, vec3 p, double *u, double *v);
 
-/* The value of a level and side at point p, interpolated. */
-vec3 map_lookup(const part_map *m, int level, int side, vec3 p);
-
 /* Builds the coarser copies of one level (after its texels are final).
  * The first call also builds the coarser weights from weight[0]. */
 int map_build_mips(part_map *m, int level);
 
-/* Like map_lookup, averaged over a footprint of about `width` scene units
- * (0: the finest grid). */
+/* The value of a level and side at point p, interpolated, averaged over a
+ * footprint of about `width` scene units (0: the finest grid). */
 vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double width);
 
 void map_free(part_map *m);
