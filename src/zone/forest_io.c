@@ -236,13 +236,24 @@ static size_t mip_weights(const part_map *m, int k)
     return (size_t)l->sides * mip_size(l->nu, k) * mip_size(l->nv, k);
 }
 
-/* What forest_build_maps derives from the final texels of a level, redone
- * after loading (keep in step with it; the save/load round trip in
- * tests/test_zone.c checks that the images stay identical): the coarser
- * copies and the summed-area tables of the transfer. */
+/* What Phase Two needs that forest_build_maps derives from the final
+ * texels of a level, redone after loading (keep in step with it; the
+ * save/load round trip in tests/test_zone.c checks that the images stay
+ * identical): the coarser copies.  The transfer's tables serve Phase One
+ * only. */
 static int derive_level(part_map *m, int level)
 {
-    return map_build_mips(m, level) && transfer_build_tables(m, level);
+    return map_build_mips(m, level);
+}
+
+static void w_axis(wbuf *w, const map_axis *a)
+{
+    w_i32(w, a->n);
+    w_i32(w, a->k0);
+    w_i32(w, a->k1);
+    w_f64(w, a->w);
+    w_f64(w, a->r);
+    w_f64(w, a->len);
 }
 
 static void write_header(wbuf *w, const zone_forest *f, const zt_renderer *r,
@@ -315,6 +326,8 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
         w_v3(&w, l->origin);
         w_v3(&w, l->du);
         w_v3(&w, l->dv);
+        w_axis(&w, &l->au);
+        w_axis(&w, &l->av);
         w_v3(&w, l->centre);
         w_f64(&w, l->radius);
         w_i32(&w, m->levels);
@@ -523,6 +536,24 @@ static zt_status check_options(const char *path, const forest_options *file,
     return zt_fail(err, ZT_ERR_PARSE, "%s%s", full, msg);
 }
 
+static map_axis r_axis(rbuf *rb)
+{
+    map_axis a;
+    a.n = r_i32(rb);
+    a.k0 = r_i32(rb);
+    a.k1 = r_i32(rb);
+    a.w = r_f64(rb);
+    a.r = r_f64(rb);
+    a.len = r_f64(rb);
+    return a;
+}
+
+static int axis_ok(const map_axis *a, int n)
+{
+    return a->n == n && a->k0 >= 0 && a->k0 < a->k1 && a->k1 <= a->n && a->w > 0 &&
+           a->r >= 1.0 && a->r < 16.0 && a->len > 0 && isfinite(a->w) && isfinite(a->len);
+}
+
 static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const char *path,
                            zt_error *err)
 {
@@ -555,6 +586,8 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
         l->origin = r_v3(rb);
         l->du = r_v3(rb);
         l->dv = r_v3(rb);
+        l->au = r_axis(rb);
+        l->av = r_axis(rb);
         l->centre = r_v3(rb);
         l->radius = r_f64(rb);
         m->levels = r_i32(rb);
@@ -562,7 +595,8 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
             return ZT_ERR_PARSE;
         if (l->shape < SHAPE_SPHERE || l->shape > SHAPE_POINT || l->nu < 1 ||
             l->nu > MAP_DIM_MAX || l->nv < 1 || l->nv > MAP_DIM_MAX || l->sides < 1 ||
-            l->sides > 2 || m->levels != f->map_levels + (f->sky_slot >= 0) || m->levels < 1)
+            l->sides > 2 || m->levels != f->map_levels + (f->sky_slot >= 0) || m->levels < 1 ||
+            !axis_ok(&l->au, l->nu) || !axis_ok(&l->av, l->nv))
             return corrupt(err, path, "bad map layout");
         m->texels = r_f32s(rb, mip_values(m, 0), &oom);
         if (m->texels)
@@ -787,9 +821,6 @@ void forest_memory(const zone_forest *f, uint64_t *zones, uint64_t *occluders, u
             continue;
         for (int k = 0; k < m->mips; k++)
             mb += (mip_values(m, k) + mip_weights(m, k)) * sizeof(float);
-        if (m->sat) /* transfer.c's summed-area tables */
-            mb += (uint64_t)m->levels * m->layout.sides * (uint64_t)(m->layout.nu + 1) *
-                  (uint64_t)(m->layout.nv + 1) * 4 * sizeof(double);
     }
     *maps = mb;
 }

@@ -4,16 +4,87 @@
 
 #define ZT_PI_D 3.14159265358979323846
 
+map_axis axis_uniform(int n, double len)
+{
+    map_axis a = {n, 0, n, len / n, 1.0, len};
+    return a;
+}
+
+/* Total width of the m texels just outside the core: w r + w r^2 + ... */
+static double outer_span(const map_axis *a, double m)
+{
+    return a->w * a->r * (pow(a->r, m) - 1.0) / (a->r - 1.0);
+}
+
+double axis_edge(const map_axis *a, int i)
+{
+    double x;
+    if (i < a->k0)
+        x = outer_span(a, a->k0) - outer_span(a, a->k0 - i);
+    else if (i <= a->k1)
+        x = (a->k0 > 0 ? outer_span(a, a->k0) : 0.0) + (i - a->k0) * a->w;
+    else
+        x = (a->k0 > 0 ? outer_span(a, a->k0) : 0.0) + (a->k1 - a->k0) * a->w +
+            outer_span(a, i - a->k1);
+    return x / a->len;
+}
+
+/* Texel coordinate of fraction s along an axis: i + 0.5 at the middle of
+ * texel i, linear inside each texel. */
+static double axis_coord(const map_axis *a, double s)
+{
+    double x = s * a->len;
+    double c0 = a->k0 > 0 ? outer_span(a, a->k0) : 0.0;
+    double c1 = c0 + (a->k1 - a->k0) * a->w;
+    int i;
+    if (x >= c0 && x <= c1) {
+        return a->k0 + (x - c0) / a->w;
+    } else if (x > c1) {
+        /* Invert outer_span for the (real) texel count, then interpolate
+         * linearly within the texel it falls in. */
+        double m = log1p((x - c1) * (a->r - 1.0) / (a->w * a->r)) / log(a->r);
+        i = a->k1 + (int)floor(m);
+    } else {
+        double m = log1p((c0 - x) * (a->r - 1.0) / (a->w * a->r)) / log(a->r);
+        i = a->k0 - 1 - (int)floor(m);
+    }
+    if (i < 0) /* before the first edge */
+        return x / a->w;
+    if (i >= a->n)
+        return a->n + (x - a->len) / a->w;
+    double e0 = axis_edge(a, i), e1 = axis_edge(a, i + 1);
+    return i + (s - e0) / (e1 - e0);
+}
+
+vec3 map_point(const map_layout *l, double s, double t)
+{
+    return v3_add(l->origin, v3_add(v3_scale(l->du, s), v3_scale(l->dv, t)));
+}
+
+/* Solves p - origin = s du + t dv in the least-squares sense (du, dv span
+ * the plane). */
+static void plane_st(const map_layout *l, vec3 p, double *s, double *t)
+{
+    vec3 r = v3_sub(p, l->origin);
+    double a = v3_dot(l->du, l->du), b = v3_dot(l->du, l->dv), c = v3_dot(l->dv, l->dv);
+    double e = v3_dot(r, l->du), f = v3_dot(r, l->dv);
+    double det = a * c - b * b;
+    *s = det != 0 ? (e * c - b * f) / det : 0;
+    *t = det != 0 ? (a * f - b * e) / det : 0;
+}
+
 void map_texel_point(const map_layout *l, int i, int j, vec3 *p, vec3 *n)
 {
-    double s = (i + 0.5) / l->nu, t = (j + 0.5) / l->nv;
     if (l->shape == SHAPE_SPHERE) {
+        double s = (i + 0.5) / l->nu, t = (j + 0.5) / l->nv;
         double theta = t * ZT_PI_D, phi = s * 2.0 * ZT_PI_D;
         *n = v3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
         *p = v3_add(l->centre, v3_scale(*n, l->radius));
         return;
     }
-    *p = v3_add(l->origin, v3_add(v3_scale(l->du, s), v3_scale(l->dv, t)));
+    double s = 0.5 * (axis_edge(&l->au, i) + axis_edge(&l->au, i + 1));
+    double t = 0.5 * (axis_edge(&l->av, j) + axis_edge(&l->av, j + 1));
+    *p = map_point(l, s, t);
     *n = v3_normalize(v3_cross(l->du, l->dv));
 }
 
@@ -29,22 +100,146 @@ void map_coords(const map_layout *l, vec3 p, double *u, double *v)
         *v = theta / ZT_PI_D * l->nv - 0.5;
         return;
     }
-    /* Solve p - origin = s du + t dv in the least-squares sense (du, dv
-     * span the plane). */
-    vec3 r = v3_sub(p, l->origin);
-    double a = v3_dot(l->du, l->du), b = v3_dot(l->du, l->dv), c = v3_dot(l->dv, l->dv);
-    double e = v3_dot(r, l->du), f = v3_dot(r, l->dv);
-    double det = a * c - b * b;
-    double s = det != 0 ? (e * c - b * f) / det : 0;
-    double t = det != 0 ? (a * f - b * e) / det : 0;
-    *u = s * l->nu - 0.5;
-    *v = t * l->nv - 0.5;
+    double s, t;
+    plane_st(l, p, &s, &t);
+    *u = axis_coord(&l->au, s) - 0.5;
+    *v = axis_coord(&l->av, t) - 0.5;
+}
+
+int poly3_clip(vec3 *q, int n, int max, vec3 a, double b)
+{
+    vec3 out[2 * MAP_CLIPS + 8];
+    int k = 0, cap = max < (int)(sizeof out / sizeof out[0]) ? max : (int)(sizeof out / sizeof out[0]);
+    for (int i = 0, j = n - 1; i < n; j = i++) {
+        double di = v3_dot(a, q[i]) + b, dj = v3_dot(a, q[j]) + b;
+        if ((dj >= 0) != (di >= 0) && k < cap)
+            out[k++] = v3_add(q[j], v3_scale(v3_sub(q[i], q[j]), dj / (dj - di)));
+        if (di >= 0 && k < cap)
+            out[k++] = q[i];
+    }
+    for (int i = 0; i < k; i++)
+        q[i] = out[i];
+    return k;
+}
+
+int map_texel_polygon(const map_layout *l, int i, int j, vec3 *q, int max)
+{
+    double s0 = axis_edge(&l->au, i), s1 = axis_edge(&l->au, i + 1);
+    double t0 = axis_edge(&l->av, j), t1 = axis_edge(&l->av, j + 1);
+    q[0] = map_point(l, s0, t0);
+    q[1] = map_point(l, s1, t0);
+    q[2] = map_point(l, s1, t1);
+    q[3] = map_point(l, s0, t1);
+    int n = 4;
+    for (int k = 0; k < l->clips && n >= 3; k++)
+        n = poly3_clip(q, n, max, l->clip_n[k], l->clip_d[k]);
+    return n;
+}
+
+static double poly3_area(const vec3 *q, int n, vec3 *centroid)
+{
+    vec3 sum = v3(0, 0, 0), c = v3(0, 0, 0);
+    double area = 0;
+    vec3 nrm = v3(0, 0, 0);
+    for (int k = 1; k + 1 < n; k++)
+        nrm = v3_add(nrm, v3_cross(v3_sub(q[k], q[0]), v3_sub(q[k + 1], q[0])));
+    double len = v3_length(nrm);
+    if (len <= 0) {
+        *centroid = q[0];
+        return 0;
+    }
+    vec3 un = v3_scale(nrm, 1.0 / len);
+    for (int k = 1; k + 1 < n; k++) {
+        double a = 0.5 * v3_dot(v3_cross(v3_sub(q[k], q[0]), v3_sub(q[k + 1], q[0])), un);
+        vec3 tc = v3_scale(v3_add(q[0], v3_add(q[k], q[k + 1])), 1.0 / 3.0);
+        sum = v3_add(sum, v3_scale(tc, a));
+        area += a;
+    }
+    c = area > 0 ? v3_scale(sum, 1.0 / area) : q[0];
+    *centroid = c;
+    return area;
+}
+
+int map_build_cover(part_map *m)
+{
+    const map_layout *l = &m->layout;
+    size_t cells = (size_t)l->nu * l->nv;
+    free(m->cover);
+    free(m->eval_st);
+    m->cover = malloc(cells * sizeof(float));
+    m->eval_st = malloc(cells * 2 * (size_t)l->sides * sizeof(float));
+    if (!m->cover || !m->eval_st)
+        return 0;
+    for (int j = 0; j < l->nv; j++)
+        for (int i = 0; i < l->nu; i++) {
+            size_t k = (size_t)j * l->nu + i;
+            double s0 = axis_edge(&l->au, i), s1 = axis_edge(&l->au, i + 1);
+            double t0 = axis_edge(&l->av, j), t1 = axis_edge(&l->av, j + 1);
+            double s = 0.5 * (s0 + s1), t = 0.5 * (t0 + t1);
+            float cover = 1.0f;
+            if (l->shape != SHAPE_SPHERE && l->clips > 0) {
+                vec3 q[2 * MAP_CLIPS + 8], full[4], c, cf;
+                int n = map_texel_polygon(l, i, j, q, 2 * MAP_CLIPS + 8);
+                full[0] = map_point(l, s0, t0);
+                full[1] = map_point(l, s1, t0);
+                full[2] = map_point(l, s1, t1);
+                full[3] = map_point(l, s0, t1);
+                double whole = poly3_area(full, 4, &cf);
+                double part = n >= 3 ? poly3_area(q, n, &c) : 0.0;
+                cover = whole > 0 ? (float)fmin(1.0, part / whole) : 0.0f;
+                if (cover > 0 && cover < 1) {
+                    /* Value at the centroid of the part inside. */
+                    plane_st(l, c, &s, &t);
+                }
+            }
+            m->cover[k] = cover;
+            for (int side = 0; side < l->sides; side++) {
+                m->eval_st[2 * (side * cells + k)] = (float)s;
+                m->eval_st[2 * (side * cells + k) + 1] = (float)t;
+            }
+        }
+    return 1;
 }
 
 static int mip_size(int n, int k)
 {
     n >>= k;
     return n > 0 ? n : 1;
+}
+
+/* Bilinear read of one level and side of mip k at normalised (s, t). */
+/* The two texels along one axis around texel coordinate u and the share
+ * of the second.  Past the first or last centre (up to the map's edge, half
+ * a texel on) the value is extrapolated linearly when `extend` is set: near
+ * a seam irradiance keeps changing to the very edge, and holding it at the
+ * last centre's value would be off by that change. */
+static void axis_pick(double u, int n, int wrap, int extend, int *i0, int *i1, double *f)
+{
+    if (wrap) {
+        int a = (int)floor(u);
+        *f = u - a;
+        *i0 = ((a % n) + n) % n;
+        *i1 = (*i0 + 1) % n;
+        return;
+    }
+    if (n < 2) {
+        *i0 = *i1 = 0;
+        *f = 0;
+        return;
+    }
+    if (u < 0 || u > n - 1) {
+        int low = u < 0;
+        *i0 = low ? 0 : n - 2;
+        *i1 = *i0 + 1;
+        *f = !extend ? (low ? 0.0 : 1.0) : low ? fmax(u, -0.5) : 1.0 + fmin(u - (n - 1), 0.5);
+        return;
+    }
+    int a = (int)floor(u);
+    if (a > n - 2)
+        a = n - 2;
+    *i0 = a;
+    *i1 = a + 1;
+    *f = u - a;
 }
 
 /* Bilinear read of one level and side of mip k at normalised (s, t). */
@@ -56,36 +251,36 @@ static vec3 bilinear(const part_map *m, int k, int level, int side, double s, do
     const float *wt = m->weight[k] + (size_t)side * nv * nu;
     double u = s * nu - 0.5, v = t * nv - 0.5;
     int wrap = l->shape == SHAPE_SPHERE;
-    if (!wrap)
-        u = fmin(fmax(u, 0.0), nu - 1.0);
-    v = fmin(fmax(v, 0.0), nv - 1.0);
-    int i0 = (int)floor(u), j0 = (int)floor(v);
-    double fu = u - i0, fv = v - j0;
-    int i1 = i0 + 1, j1 = j0 + 1 < nv ? j0 + 1 : j0;
-    if (wrap) {
-        i0 = ((i0 % nu) + nu) % nu;
-        i1 = i1 % nu;
-    } else if (i1 >= nu) {
-        i1 = i0;
+    for (int extend = 1; extend >= 0; extend--) {
+        int i0, i1, j0, j1;
+        double fu, fv;
+        axis_pick(u, nu, wrap, extend, &i0, &i1, &fu);
+        axis_pick(v, nv, 0, extend, &j0, &j1, &fv);
+        size_t idx[4] = {(size_t)j0 * nu + i0, (size_t)j0 * nu + i1, (size_t)j1 * nu + i0,
+                         (size_t)j1 * nu + i1};
+        double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
+        int outside = fu < 0 || fu > 1 || fv < 0 || fv > 1;
+        if (outside && (wt[idx[0]] <= 0 || wt[idx[1]] <= 0 || wt[idx[2]] <= 0 || wt[idx[3]] <= 0))
+            continue; /* extrapolate only from four reachable texels */
+        /* Texels off the reachable surface do not take part; the values
+         * are weighted means, so they are scaled back by their weights. */
+        double sw = 0;
+        vec3 r = v3(0, 0, 0);
+        vec3 plain = v3(0, 0, 0);
+        for (int q = 0; q < 4; q++) {
+            double ww = w[q] * wt[idx[q]];
+            const float *px = base + idx[q] * 3;
+            vec3 val = v3(px[0], px[1], px[2]);
+            r = v3_add(r, v3_scale(val, ww));
+            plain = v3_add(plain, v3_scale(val, w[q]));
+            sw += ww;
+        }
+        /* Nothing reachable around: the plain bilinear value.  (Not
+         * clamped at zero where extrapolated: light must add up linearly,
+         * light by light.) */
+        return sw > 1e-6 ? v3_scale(r, 1.0 / sw) : plain;
     }
-    size_t idx[4] = {(size_t)j0 * nu + i0, (size_t)j0 * nu + i1, (size_t)j1 * nu + i0,
-                     (size_t)j1 * nu + i1};
-    double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
-    /* Texels off the reachable surface do not take part; the values are
-     * weighted means, so they are scaled back by their weights. */
-    double sw = 0;
-    vec3 r = v3(0, 0, 0);
-    vec3 plain = v3(0, 0, 0);
-    for (int q = 0; q < 4; q++) {
-        double ww = w[q] * wt[idx[q]];
-        const float *px = base + idx[q] * 3;
-        vec3 val = v3(px[0], px[1], px[2]);
-        r = v3_add(r, v3_scale(val, ww));
-        plain = v3_add(plain, v3_scale(val, w[q]));
-        sw += ww;
-    }
-    /* Nothing reachable around: the plain bilinear value. */
-    return sw > 1e-6 ? v3_scale(r, 1.0 / sw) : plain;
+    return v3(0, 0, 0);
 }
 
 vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double width)
@@ -100,7 +295,7 @@ vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double widt
     double s = (u + 0.5) / l->nu, t = (v + 0.5) / l->nv;
     double texel = l->shape == SHAPE_SPHERE
                        ? 3.14159265358979 * l->radius / l->nv
-                       : 0.5 * (v3_length(l->du) / l->nu + v3_length(l->dv) / l->nv);
+                       : 0.5 * (l->au.w + l->av.w); /* the core's texels */
     double lod = width > texel ? log2(width / texel) : 0.0;
     if (lod > m->mips - 1)
         lod = m->mips - 1;
@@ -165,6 +360,16 @@ int map_build_mips(part_map *m, int level)
     return 1;
 }
 
+void map_free_phase_one(part_map *m)
+{
+    free(m->sat);
+    free(m->cover);
+    free(m->eval_st);
+    m->sat = NULL;
+    m->cover = NULL;
+    m->eval_st = NULL;
+}
+
 void map_free(part_map *m)
 {
     free(m->texels);
@@ -173,4 +378,6 @@ void map_free(part_map *m)
     for (int k = 0; k < MAP_MIPS; k++)
         free(m->weight[k]);
     free(m->sat);
+    free(m->cover);
+    free(m->eval_st);
 }

@@ -9,14 +9,34 @@
 #include "scene/scene.h"
 #include "util/vec3.h"
 
+/* Where the texel edges of one planar axis lie.  Texels [k0, k1) are the
+ * core, of equal width w; outside it each texel is r times wider than its
+ * inner neighbour, so a plane's map reaches far from the scene for a few
+ * texels more.  Widths are in scene units; the axis is len long. */
+typedef struct map_axis {
+    int n, k0, k1;
+    double w, r, len;
+} map_axis;
+
+/* At most this many half-planes bound the mapped part of a surface. */
+#define MAP_CLIPS 12
+
 /* How a part's surface is laid out on its grid. */
 typedef struct map_layout {
     int shape;          /* part_shape */
     int nu, nv;         /* grid size */
     vec3 origin, du, dv;/* planar: point = origin + s*du + t*dv, s,t in [0,1] */
+    map_axis au, av;    /* planar: texel edges along du and dv */
     vec3 centre;        /* sphere: centre, radius */
     double radius;
     int sides;          /* 1 (front only) or 2 */
+    /* Planar: the surface that exists and can be lit is the part of the
+     * parallelogram where clip_n[k] . p + clip_d[k] >= 0 for every k (a
+     * triangle's far diagonal; for a plane, the walls of the room it lies
+     * in).  Phase One only: not saved with a forest. */
+    int clips;
+    vec3 clip_n[MAP_CLIPS];
+    double clip_d[MAP_CLIPS];
 } map_layout;
 
 #define MAP_MIPS 8
@@ -34,13 +54,39 @@ typedef struct part_map {
      * (0 for texel centres inside closed objects or outside the room); the
      * same for every level.  weight[0] is the grid's, the rest the copies'. */
     float *weight[MAP_MIPS];
+    /* Per texel, the share of its area inside the clipped surface, and per
+     * side and texel the point (s, t) where its value is computed: the
+     * centre, or a point of the part that exists and can be lit.  Phase
+     * One only. */
+    float *cover;
+    float *eval_st;
     /* Summed-area tables per level and side: [level][side][(nv+1)*(nu+1)]
-     * of weight*rgb (3 doubles) and weight, built by transfer.c. */
+     * of area*weight*rgb (3 doubles) and area, built by transfer.c. */
     double *sat;
 } part_map;
 
 /* Texel centre (i, j) of the layout as a point and the surface normal. */
 void map_texel_point(const map_layout *l, int i, int j, vec3 *p, vec3 *n);
+
+/* Edge i (0..n) of an axis as a fraction of its length. */
+double axis_edge(const map_axis *a, int i);
+
+/* An axis with n equal texels. */
+map_axis axis_uniform(int n, double len);
+
+/* The point at (s, t) of a planar layout. */
+vec3 map_point(const map_layout *l, double s, double t);
+
+/* Texel (i, j) of a planar layout as a polygon (4 corners, then clipped to
+ * the surface); returns the corner count, under 3 when nothing is left. */
+int map_texel_polygon(const map_layout *l, int i, int j, vec3 *q, int max);
+
+/* Keeps the part of polygon q (n corners, room for max) where
+ * a . p + b >= 0; returns the new corner count. */
+int poly3_clip(vec3 *q, int n, int max, vec3 a, double b);
+
+/* Computes cover and eval_st of a planar map from its layout. */
+int map_build_cover(part_map *m);
 
 /* Where point p (on the part) falls on the grid, in texel units. */
 void map_coords(const map_layout *l, vec3 p, double *u, double *v);
@@ -52,6 +98,10 @@ int map_build_mips(part_map *m, int level);
 /* The value of a level and side at point p, interpolated, averaged over a
  * footprint of about `width` scene units (0: the finest grid). */
 vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double width);
+
+/* Frees what only Phase One uses (cover, evaluation points, the
+ * transfer's tables). */
+void map_free_phase_one(part_map *m);
 
 void map_free(part_map *m);
 
