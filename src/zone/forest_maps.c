@@ -489,8 +489,9 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
         if (!m->texels || !m->weight[0] || !map_build_cover(m))
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
     }
+    f->blockers = transfer_blockers_build(sc);
     vec3 *dirs = gather_directions(f->q.gather);
-    if (!dirs)
+    if (!dirs || !f->blockers)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     f->dirs = dirs;
     /* Gathers are needed for what transfer does not cover: light arriving
@@ -574,6 +575,7 @@ void forest_free(zone_forest *f)
             map_free(&f->maps[i]);
     free(f->maps);
     free(f->dirs);
+    transfer_blockers_free(f->blockers);
     free(f->zones);
     free(f->occluders);
 }

@@ -66,10 +66,158 @@ static vec3 sat_sum(const part_map *m, int level, int side, int i0, int j0, int 
     return v3(a[0] - b[0] - c[0] + d[0], a[1] - b[1] - c[1] + d[1], a[2] - b[2] - c[2] + d[2]);
 }
 
+/* What could stand between a receiver and a piece: the box of every
+ * finite part, and every plane.  A piece whose pyramid (receiver to piece)
+ * meets none of them is seen whole, with no ray cast. */
+#define BLOCKER_BOXES_MAX 256
+#define PIECE_MAX (2 * MAP_CLIPS + 8)
+
+struct transfer_blockers {
+    int boxes;          /* -1: too many parts to test, cast rays */
+    vec3 *lo, *hi;
+    int *box_part;
+    int planes;
+    vec3 *pn;
+    double *pd;
+    int *plane_part;
+    double eps;
+};
+
+transfer_blockers *transfer_blockers_build(const zt_scene *sc)
+{
+    transfer_blockers *b = calloc(1, sizeof *b);
+    if (!b)
+        return NULL;
+    int n = sc->part_count;
+    b->lo = malloc((size_t)(n + 1) * sizeof(vec3));
+    b->hi = malloc((size_t)(n + 1) * sizeof(vec3));
+    b->box_part = malloc((size_t)(n + 1) * sizeof(int));
+    b->pn = malloc((size_t)(n + 1) * sizeof(vec3));
+    b->pd = malloc((size_t)(n + 1) * sizeof(double));
+    b->plane_part = malloc((size_t)(n + 1) * sizeof(int));
+    if (!b->lo || !b->hi || !b->box_part || !b->pn || !b->pd || !b->plane_part) {
+        transfer_blockers_free(b);
+        return NULL;
+    }
+    vec3 slo, shi;
+    forest_scene_bounds(sc, &slo, &shi);
+    b->eps = 1e-7 * (1.0 + v3_length(v3_sub(shi, slo)));
+    for (int i = 0; i < n; i++) {
+        const part *p = &sc->parts[i];
+        if (p->shape == SHAPE_PLANE) {
+            b->pn[b->planes] = p->normal;
+            b->pd[b->planes] = p->offset;
+            b->plane_part[b->planes++] = i;
+        } else if (p->shape == SHAPE_TRIANGLE) {
+            b->lo[b->boxes] = v3_min3(v3_min3(p->p[0], p->p[1]), p->p[2]);
+            b->hi[b->boxes] = v3_max3(v3_max3(p->p[0], p->p[1]), p->p[2]);
+            b->box_part[b->boxes++] = i;
+        } else if (p->shape == SHAPE_SPHERE) {
+            vec3 r = v3(p->radius, p->radius, p->radius);
+            b->lo[b->boxes] = v3_sub(p->p[0], r);
+            b->hi[b->boxes] = v3_add(p->p[0], r);
+            b->box_part[b->boxes++] = i;
+        }
+    }
+    if (b->boxes > BLOCKER_BOXES_MAX)
+        b->boxes = -1;
+    return b;
+}
+
+void transfer_blockers_free(transfer_blockers *b)
+{
+    if (!b)
+        return;
+    free(b->lo);
+    free(b->hi);
+    free(b->box_part);
+    free(b->pn);
+    free(b->pd);
+    free(b->plane_part);
+    free(b);
+}
+
+/* Whether box [lo, hi] lies wholly on the negative side of plane
+ * a . p + d = 0 (beyond eps). */
+static int box_outside(vec3 lo, vec3 hi, vec3 a, double d, double eps)
+{
+    vec3 far = v3(a.x >= 0 ? hi.x : lo.x, a.y >= 0 ? hi.y : lo.y, a.z >= 0 ? hi.z : lo.z);
+    return v3_dot(a, far) + d < -eps;
+}
+
+/* Whether something may hide part of polygon q (n corners) from x: a part
+ * whose box meets the pyramid from x over q, or a plane between them. */
+static int maybe_blocked(const transfer_blockers *b, int receiver, int source, vec3 x,
+                         const vec3 *q, int n)
+{
+    if (!b || b->boxes < 0)
+        return 1;
+    vec3 lo = x, hi = x, c = v3(0, 0, 0);
+    for (int k = 0; k < n; k++) {
+        lo = v3_min3(lo, q[k]);
+        hi = v3_max3(hi, q[k]);
+        c = v3_add(c, q[k]);
+    }
+    c = v3_scale(c, 1.0 / n);
+    /* The pyramid's faces, each plane oriented to have the inside positive. */
+    vec3 fa[PIECE_MAX + 1];
+    double fd[PIECE_MAX + 1];
+    int faces = 0;
+    for (int k = 0; k < n; k++) {
+        vec3 a = v3_cross(v3_sub(q[k], x), v3_sub(q[(k + 1) % n], x));
+        double len = v3_length(a);
+        if (len <= 0)
+            continue;
+        a = v3_scale(a, 1.0 / len);
+        double d = -v3_dot(a, x);
+        if (v3_dot(a, c) + d < 0) {
+            a = v3_scale(a, -1);
+            d = -d;
+        }
+        fa[faces] = a;
+        fd[faces++] = d;
+    }
+    vec3 base = v3_cross(v3_sub(q[1], q[0]), v3_sub(q[2], q[0]));
+    double blen = v3_length(base);
+    if (blen > 0) {
+        base = v3_scale(base, 1.0 / blen);
+        double d = -v3_dot(base, q[0]);
+        if (v3_dot(base, x) + d < 0) {
+            base = v3_scale(base, -1);
+            d = -d;
+        }
+        fa[faces] = base;
+        fd[faces++] = d;
+    }
+    for (int i = 0; i < b->boxes; i++) {
+        if (b->box_part[i] == receiver || b->box_part[i] == source)
+            continue;
+        if (!(b->lo[i].x <= hi.x && b->hi[i].x >= lo.x && b->lo[i].y <= hi.y &&
+              b->hi[i].y >= lo.y && b->lo[i].z <= hi.z && b->hi[i].z >= lo.z))
+            continue;
+        int out = 0;
+        for (int k = 0; k < faces && !out; k++)
+            out = box_outside(b->lo[i], b->hi[i], fa[k], fd[k], b->eps);
+        if (!out)
+            return 1;
+    }
+    for (int i = 0; i < b->planes; i++) {
+        if (b->plane_part[i] == receiver || b->plane_part[i] == source)
+            continue;
+        double dx = v3_dot(b->pn[i], x) - b->pd[i];
+        for (int k = 0; k < n; k++) {
+            double dk = v3_dot(b->pn[i], q[k]) - b->pd[i];
+            if ((dx > b->eps && dk < -b->eps) || (dx < -b->eps && dk > b->eps))
+                return 1;
+        }
+    }
+    return 0;
+}
+
 typedef struct source {
     const part_map *m;
     const part *p;
-    int level, side, background;
+    int index, level, side, background;
     vec3 scale;        /* w_d * rho / pi: radiance per irradiance */
 } source;
 
@@ -79,20 +227,71 @@ typedef struct receiver {
     vec3f origin;      /* x moved off its surface */
     double theta;
     int background;    /* the source's flag, for visibility rays */
+    int part;
 } receiver;
 
-#define PIECE_MAX (2 * MAP_CLIPS + 8)
 
-/* The form factor from the receiver to the part of rectangle [s0,s1] x
- * [t0,t1] of the source's layout that exists and lies above the receiver's
- * horizon, if the receiver sees that part's centroid (else 0). */
-static double seen_form_factor(const receiver *r, const map_layout *l, double s0, double t0,
-                               double s1, double t1)
+/* Whether the receiver sees point c (a ray short of it). */
+static int sees(const receiver *r, vec3 c)
 {
-    vec3 q[PIECE_MAX];
+    vec3f d = f3_sub(f3((float)c.x, (float)c.y, (float)c.z), r->origin);
+    float len = f3_length(d);
+    r->t->rays++;
+    return len > 0 && !accel_occluded(&r->t->r->rs, r->origin, f3_scale(d, 1.0f / len),
+                                      len * 0.999f, r->background);
+}
+
+/* Whether the receiver sees polygon q (n corners): with no ray when nothing
+ * can stand in between, else by a ray to its centroid.  (Rays to its
+ * corners as well, splitting pieces they disagree on, measured 1.85%
+ * instead of 2.17% at level 2 for 7x the rays; a finer quality pays
+ * better.) */
+static int seen(const receiver *r, const source *src, const vec3 *q, int n)
+{
+    if (!maybe_blocked(r->t->f->blockers, r->part, src->index, r->x, q, n))
+        return 1;
+    vec3 c = v3(0, 0, 0);
+    for (int i = 0; i < n; i++)
+        c = v3_add(c, q[i]);
+    return sees(r, v3_scale(c, 1.0 / n));
+}
+
+static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, int j1);
+
+/* The piece in two halves, across its longer side. */
+static vec3 split(const receiver *r, const source *src, int i0, int j0, int i1, int j1)
+{
+    const map_layout *l = &src->m->layout;
+    double ls = (axis_edge(&l->au, i1) - axis_edge(&l->au, i0)) * l->au.len;
+    double lt = (axis_edge(&l->av, j1) - axis_edge(&l->av, j0)) * l->av.len;
+    if ((ls >= lt && i1 - i0 > 1) || j1 - j0 < 2) {
+        int im = (i0 + i1) / 2;
+        return v3_add(piece(r, src, i0, j0, im, j1), piece(r, src, im, j0, i1, j1));
+    }
+    int jm = (j0 + j1) / 2;
+    return v3_add(piece(r, src, i0, j0, i1, jm), piece(r, src, i0, jm, i1, j1));
+}
+
+static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, int j1)
+{
+    const map_layout *l = &src->m->layout;
+    double s0 = axis_edge(&l->au, i0), s1 = axis_edge(&l->au, i1);
+    double t0 = axis_edge(&l->av, j0), t1 = axis_edge(&l->av, j1);
+    vec3 q[PIECE_MAX]; /* not zeroed: this runs for every piece */
     q[0] = map_point(l, s0, t0);
-    q[1] = map_point(l, s1, t0);
     q[2] = map_point(l, s1, t1);
+    vec3 centre = v3_scale(v3_add(q[0], q[2]), 0.5);
+    double size = v3_length(v3_sub(q[2], q[0]));
+    double dist = v3_length(v3_sub(centre, r->x));
+    int splittable = i1 - i0 > 1 || j1 - j0 > 1;
+    if (size > r->theta * dist && splittable)
+        return split(r, src, i0, j0, i1, j1);
+    double area;
+    vec3 sum = sat_sum(src->m, src->level, src->side, i0, j0, i1, j1, &area);
+    if (area <= 0 || (sum.x <= 0 && sum.y <= 0 && sum.z <= 0))
+        return v3(0, 0, 0);
+    vec3 radiance = v3_mul(v3_scale(sum, 1.0 / area), src->scale);
+    q[1] = map_point(l, s1, t0);
     q[3] = map_point(l, s0, t1);
     int n = 4;
     /* Only the surface that exists (a triangle, a plane inside its room)... */
@@ -102,51 +301,11 @@ static double seen_form_factor(const receiver *r, const map_layout *l, double s0
     if (n >= 3)
         n = poly3_clip(q, n, PIECE_MAX, r->n, -v3_dot(r->n, r->x));
     if (n < 3)
-        return 0;
+        return v3(0, 0, 0);
     double ff = lambert_polygon(r->x, r->n, q, n);
     if (ff <= 0)
-        return 0;
-    vec3 c = v3(0, 0, 0);
-    for (int i = 0; i < n; i++)
-        c = v3_add(c, q[i]);
-    c = v3_scale(c, 1.0 / n);
-    vec3f target = f3((float)c.x, (float)c.y, (float)c.z);
-    vec3f d = f3_sub(target, r->origin);
-    float len = f3_length(d);
-    r->t->rays++;
-    if (len <= 0 || accel_occluded(&r->t->r->rs, r->origin, f3_scale(d, 1.0f / len),
-                                   len * 0.999f, r->background))
-        return 0;
-    return ff;
-}
-
-static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, int j1)
-{
-    const map_layout *l = &src->m->layout;
-    double s0 = axis_edge(&l->au, i0), s1 = axis_edge(&l->au, i1);
-    double t0 = axis_edge(&l->av, j0), t1 = axis_edge(&l->av, j1);
-    vec3 a = map_point(l, s0, t0), b = map_point(l, s1, t1);
-    vec3 centre = v3_scale(v3_add(a, b), 0.5);
-    double size = v3_length(v3_sub(b, a));
-    double dist = v3_length(v3_sub(centre, r->x));
-    if (size > r->theta * dist && (i1 - i0 > 1 || j1 - j0 > 1)) {
-        /* Split the longer side in two. */
-        vec3 e = v3(0, 0, 0);
-        if (((s1 - s0) * l->au.len >= (t1 - t0) * l->av.len && i1 - i0 > 1) || j1 - j0 < 2) {
-            int im = (i0 + i1) / 2;
-            e = v3_add(piece(r, src, i0, j0, im, j1), piece(r, src, im, j0, i1, j1));
-        } else {
-            int jm = (j0 + j1) / 2;
-            e = v3_add(piece(r, src, i0, j0, i1, jm), piece(r, src, i0, jm, i1, j1));
-        }
-        return e;
-    }
-    double area;
-    vec3 sum = sat_sum(src->m, src->level, src->side, i0, j0, i1, j1, &area);
-    if (area <= 0 || (sum.x <= 0 && sum.y <= 0 && sum.z <= 0))
         return v3(0, 0, 0);
-    vec3 radiance = v3_mul(v3_scale(sum, 1.0 / area), src->scale);
-    return v3_scale(radiance, seen_form_factor(r, l, s0, t0, s1, t1));
+    return seen(r, src, q, n) ? v3_scale(radiance, ff) : v3(0, 0, 0);
 }
 
 vec3 transfer_irradiance(zone_trace *t, int receiver_part, vec3 x, vec3 n, int level,
@@ -154,7 +313,7 @@ vec3 transfer_irradiance(zone_trace *t, int receiver_part, vec3 x, vec3 n, int l
 {
     const zone_forest *f = t->f;
     const zt_scene *sc = t->r->scene;
-    receiver r = {t, x, n, f3(0, 0, 0), theta, 0};
+    receiver r = {t, x, n, f3(0, 0, 0), theta, 0, receiver_part};
     r.origin = ray_offset(f3((float)x.x, (float)x.y, (float)x.z),
                           f3((float)n.x, (float)n.y, (float)n.z));
     vec3 e = v3(0, 0, 0);
@@ -169,7 +328,7 @@ vec3 transfer_irradiance(zone_trace *t, int receiver_part, vec3 x, vec3 n, int l
         int side = side_dist > 0 ? 0 : 1;
         if (side >= m->layout.sides || side_dist == 0)
             continue;
-        source src = {m, p, level - 1, side, o->background,
+        source src = {m, p, i, level - 1, side, o->background,
                       v3_scale(o->mat.color, o->mat.weight[LOBE_DIFFUSE] / 3.14159265358979)};
         r.background = o->background;
         e = v3_add(e, piece(&r, &src, 0, 0, m->layout.nu, m->layout.nv));

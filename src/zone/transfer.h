@@ -13,6 +13,11 @@
 
 #include "zone/zone_internal.h"
 
+/* What may hide a piece from a receiver (transfer.c); NULL when out of
+ * memory. */
+transfer_blockers *transfer_blockers_build(const zt_scene *sc);
+void transfer_blockers_free(transfer_blockers *b);
+
 /* Summed-area tables of one map level (weight*value and weight), for mean
  * values over texel rectangles in constant time. */
 int transfer_build_tables(part_map *m, int level);

@@ -44,6 +44,8 @@ typedef struct zone_quality {
     int max_texels;     /* at most this many texels along a map's side */
 } zone_quality;
 
+typedef struct transfer_blockers transfer_blockers;
+
 typedef struct zone_forest {
     zone *zones;
     int zone_count, zone_capacity;
@@ -59,6 +61,7 @@ typedef struct zone_forest {
     zone_quality q;
     int need_gather;    /* some light arrives by specular surfaces or spheres */
     vec3 *dirs;         /* the gather directions (q.gather of them) */
+    transfer_blockers *blockers; /* Phase One: what may hide a piece */
     double phase_one_seconds;
     uint64_t rays;
     int loaded;         /* read from a forest file (forest_io.c), not built */
