@@ -545,6 +545,7 @@ static map_axis r_axis(rbuf *rb)
     a.w = r_f64(rb);
     a.r = r_f64(rb);
     a.len = r_f64(rb);
+    a.edge = NULL;
     return a;
 }
 
@@ -598,6 +599,8 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
             l->sides > 2 || m->levels != f->map_levels + (f->sky_slot >= 0) || m->levels < 1 ||
             !axis_ok(&l->au, l->nu) || !axis_ok(&l->av, l->nv))
             return corrupt(err, path, "bad map layout");
+        if (!map_layout_cache(l))
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
         m->texels = r_f32s(rb, mip_values(m, 0), &oom);
         if (m->texels)
             m->weight[0] = r_f32s(rb, mip_weights(m, 0), &oom);

@@ -486,7 +486,7 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                    (size_t)m->layout.nv * 3;
         m->texels = calloc(n, sizeof(float));
         m->weight[0] = calloc((size_t)m->layout.sides * m->layout.nu * m->layout.nv, sizeof(float));
-        if (!m->texels || !m->weight[0] || !map_build_cover(m))
+        if (!m->texels || !m->weight[0] || !map_layout_cache(&m->layout) || !map_build_cover(m))
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
     }
     f->blockers = transfer_blockers_build(sc);

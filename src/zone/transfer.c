@@ -145,23 +145,10 @@ static int box_outside(vec3 lo, vec3 hi, vec3 a, double d, double eps)
     return v3_dot(a, far) + d < -eps;
 }
 
-/* Whether something may hide part of polygon q (n corners) from x: a part
- * whose box meets the pyramid from x over q, or a plane between them. */
-static int maybe_blocked(const transfer_blockers *b, int receiver, int source, vec3 x,
-                         const vec3 *q, int n)
+/* The faces of the pyramid from x over polygon q (n corners, centroid c)
+ * as planes fa . p + fd = 0, positive inside; returns their count. */
+static int pyramid_faces(vec3 x, const vec3 *q, int n, vec3 c, vec3 *fa, double *fd)
 {
-    if (!b || b->boxes < 0)
-        return 1;
-    vec3 lo = x, hi = x, c = v3(0, 0, 0);
-    for (int k = 0; k < n; k++) {
-        lo = v3_min3(lo, q[k]);
-        hi = v3_max3(hi, q[k]);
-        c = v3_add(c, q[k]);
-    }
-    c = v3_scale(c, 1.0 / n);
-    /* The pyramid's faces, each plane oriented to have the inside positive. */
-    vec3 fa[PIECE_MAX + 1];
-    double fd[PIECE_MAX + 1];
     int faces = 0;
     for (int k = 0; k < n; k++) {
         vec3 a = v3_cross(v3_sub(q[k], x), v3_sub(q[(k + 1) % n], x));
@@ -189,12 +176,36 @@ static int maybe_blocked(const transfer_blockers *b, int receiver, int source, v
         fa[faces] = base;
         fd[faces++] = d;
     }
+    return faces;
+}
+
+/* Whether something may hide part of polygon q (n corners) from x: a part
+ * whose box meets the pyramid from x over q, or a plane between them. */
+static int maybe_blocked(const transfer_blockers *b, int receiver, int source, vec3 x,
+                         const vec3 *q, int n)
+{
+    if (!b || b->boxes < 0)
+        return 1;
+    vec3 lo = x, hi = x, c = v3(0, 0, 0);
+    for (int k = 0; k < n; k++) {
+        lo = v3_min3(lo, q[k]);
+        hi = v3_max3(hi, q[k]);
+        c = v3_add(c, q[k]);
+    }
+    c = v3_scale(c, 1.0 / n);
+    /* The pyramid's faces (each plane oriented to have the inside
+     * positive), made when a box first meets the pyramid's box. */
+    vec3 fa[PIECE_MAX + 1];
+    double fd[PIECE_MAX + 1];
+    int faces = -1;
     for (int i = 0; i < b->boxes; i++) {
         if (b->box_part[i] == receiver || b->box_part[i] == source)
             continue;
         if (!(b->lo[i].x <= hi.x && b->hi[i].x >= lo.x && b->lo[i].y <= hi.y &&
               b->hi[i].y >= lo.y && b->lo[i].z <= hi.z && b->hi[i].z >= lo.z))
             continue;
+        if (faces < 0)
+            faces = pyramid_faces(x, q, n, c, fa, fd);
         int out = 0;
         for (int k = 0; k < faces && !out; k++)
             out = box_outside(b->lo[i], b->hi[i], fa[k], fd[k], b->eps);

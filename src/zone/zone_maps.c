@@ -6,7 +6,7 @@
 
 map_axis axis_uniform(int n, double len)
 {
-    map_axis a = {n, 0, n, len / n, 1.0, len};
+    map_axis a = {n, 0, n, len / n, 1.0, len, NULL};
     return a;
 }
 
@@ -16,7 +16,7 @@ static double outer_span(const map_axis *a, double m)
     return a->w * a->r * (pow(a->r, m) - 1.0) / (a->r - 1.0);
 }
 
-double axis_edge(const map_axis *a, int i)
+static double edge_formula(const map_axis *a, int i)
 {
     double x;
     if (i < a->k0)
@@ -27,6 +27,22 @@ double axis_edge(const map_axis *a, int i)
         x = (a->k0 > 0 ? outer_span(a, a->k0) : 0.0) + (a->k1 - a->k0) * a->w +
             outer_span(a, i - a->k1);
     return x / a->len;
+}
+
+static int axis_cache(map_axis *a)
+{
+    free(a->edge);
+    a->edge = malloc((size_t)(a->n + 1) * sizeof(double));
+    if (!a->edge)
+        return 0;
+    for (int i = 0; i <= a->n; i++)
+        a->edge[i] = edge_formula(a, i);
+    return 1;
+}
+
+int map_layout_cache(map_layout *l)
+{
+    return axis_cache(&l->au) && axis_cache(&l->av);
 }
 
 /* Texel coordinate of fraction s along an axis: i + 0.5 at the middle of
@@ -108,6 +124,11 @@ void map_coords(const map_layout *l, vec3 p, double *u, double *v)
 
 int poly3_clip(vec3 *q, int n, int max, vec3 a, double b)
 {
+    int all_in = 1;
+    for (int i = 0; i < n && all_in; i++)
+        all_in = v3_dot(a, q[i]) + b >= 0;
+    if (all_in) /* the common case: nothing to cut */
+        return n;
     vec3 out[2 * MAP_CLIPS + 8];
     int k = 0, cap = max < (int)(sizeof out / sizeof out[0]) ? max : (int)(sizeof out / sizeof out[0]);
     for (int i = 0, j = n - 1; i < n; j = i++) {
@@ -372,6 +393,8 @@ void map_free_phase_one(part_map *m)
 
 void map_free(part_map *m)
 {
+    free(m->layout.au.edge);
+    free(m->layout.av.edge);
     free(m->texels);
     for (int k = 1; k < m->mips; k++)
         free(m->mip[k]);

@@ -16,6 +16,8 @@
 typedef struct map_axis {
     int n, k0, k1;
     double w, r, len;
+    double *edge;       /* the n + 1 edges as fractions of len (a cache of
+                           the formula, made by map_layout_cache) */
 } map_axis;
 
 /* At most this many half-planes bound the mapped part of a surface. */
@@ -69,7 +71,10 @@ typedef struct part_map {
 void map_texel_point(const map_layout *l, int i, int j, vec3 *p, vec3 *n);
 
 /* Edge i (0..n) of an axis as a fraction of its length. */
-double axis_edge(const map_axis *a, int i);
+static inline double axis_edge(const map_axis *a, int i) { return a->edge[i]; }
+
+/* Fills the edge caches of a layout's axes; 0 when out of memory. */
+int map_layout_cache(map_layout *l);
 
 /* An axis with n equal texels. */
 map_axis axis_uniform(int n, double len);
