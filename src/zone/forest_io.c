@@ -519,13 +519,13 @@ static zt_status check_options(const char *path, const forest_options *file,
         lights_text(b, sizeof b, want);
         snprintf(msg, sizeof msg, "lights off %s, this render %s", a, b);
     } else if (file->gather != want->gather)
-        snprintf(msg, sizeof msg, "%d gather directions, this render %d (ZT_ZONE_GATHER)",
+        snprintf(msg, sizeof msg, "%d gather directions, this render %d",
                  file->gather, want->gather);
     else if (memcmp(&file->texel_divisor, &want->texel_divisor, sizeof(double)) != 0)
-        snprintf(msg, sizeof msg, "texel divisor %g, this render %g (ZT_ZONE_TEXEL)",
+        snprintf(msg, sizeof msg, "texel divisor %g, this render %g",
                  file->texel_divisor, want->texel_divisor);
     else if (memcmp(&file->theta, &want->theta, sizeof(double)) != 0)
-        snprintf(msg, sizeof msg, "transfer threshold %g, this render %g (ZT_ZONE_THETA)",
+        snprintf(msg, sizeof msg, "transfer threshold %g, this render %g",
                  file->theta, want->theta);
     else if (file->sides != want->sides || file->aa != want->aa)
         snprintf(msg, sizeof msg, "other quality settings");

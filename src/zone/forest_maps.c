@@ -304,7 +304,7 @@ static vec3 direct_light_at(zone_trace *t, int part_index, vec3 x, vec3 n)
 
 /* One texel of one level and side. */
 static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int level,
-                        vec3 x, vec3 n, const vec3 *dirs)
+                        vec3 x, vec3 n, const vec3 *dirs, double theta)
 {
     const rscene *rs = &t->r->rs;
     vec3 e = v3(0, 0, 0);
@@ -314,7 +314,7 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
             return e;
     } else {
         /* Flat diffuse surfaces by exact transfer over their maps. */
-        e = transfer_irradiance(t, part_index, x, n, level, f->q.theta);
+        e = transfer_irradiance(t, part_index, x, n, level, theta);
         if (!f->need_gather)
             return e;
     }
@@ -397,6 +397,19 @@ static vec3 sky_texel(zone_trace *t, const zone_forest *f, vec3 x, vec3 n, const
         open += h.part < 0;
     }
     return v3_scale(v3(rs->sky.x, rs->sky.y, rs->sky.z), 3.14159265358979 * open / f->q.gather);
+}
+
+/* How many times wider texel (u, j) is than the core's texels.  A texel
+ * far out on a plane stands for a large area seen from far away: its
+ * transfer may be as coarse, relative to its distance, as it is wide. */
+static double texel_growth(const part_map *m, int u, int j)
+{
+    const map_layout *l = &m->layout;
+    if (l->shape == SHAPE_SPHERE)
+        return 1.0;
+    double gu = (axis_edge(&l->au, u + 1) - axis_edge(&l->au, u)) * l->au.len / l->au.w;
+    double gv = (axis_edge(&l->av, j + 1) - axis_edge(&l->av, j)) * l->av.len / l->av.w;
+    return fmax(1.0, fmax(gu, gv));
 }
 
 /* Where texel (u, j) of a map is lit: its centre, or for a texel cut by
@@ -547,7 +560,8 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                     int reachable = m->weight[0][((size_t)side * m->layout.nv + j) * m->layout.nu + u] > 0;
                     vec3 e = !reachable             ? v3(0, 0, 0)
                              : level == f->sky_slot ? sky_texel(&t, f, x, n, dirs)
-                                                    : texel_value(&t, f, i, level, x, n, dirs);
+                                                    : texel_value(&t, f, i, level, x, n, dirs,
+                                                                  f->q.theta * texel_growth(m, u, j));
                     float *px = map_texel(m, level, side, u, j);
                     px[0] = (float)e.x;
                     px[1] = (float)e.y;

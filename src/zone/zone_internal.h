@@ -69,8 +69,7 @@ typedef struct zone_forest {
     int images;         /* images rendered from it so far */
 } zone_forest;
 
-/* The quality settings of --quality q for scene sc (env ZT_ZONE_GATHER and
- * ZT_ZONE_TEXEL override the gather count and the texel divisor). */
+/* The quality settings of --quality q for scene sc. */
 zone_quality zone_quality_for(const zt_scene *sc, int q);
 
 /* Phase One pieces. */

@@ -22,7 +22,7 @@ zone_quality zone_quality_for(const zt_scene *sc, int q)
     z.gather = 32 << q;
     z.texel_divisor = 20.0 * step;
     z.texel = extent / z.texel_divisor;
-    z.max_texels = (int)(48.0 * step); /* planes are mapped 3x the core */
+    z.max_texels = (int)(48.0 * step); /* a side, over the core */
     z.sides = 16 << (q / 2);
     z.aa = q < 3 ? 1 : 2;
     z.theta = 0.5 / step;
