@@ -18,13 +18,14 @@
 #define EDGE_GRID 16   /* sub-pixel grid for coverage at edges */
 #define EDGE_SHADE 4   /* shaded samples per side of that grid */
 #define SEEN_MAX 8     /* light parts listed per pixel */
+#define CURVED_GRID 2  /* sub-pixel grid of smooth pixels that see a sphere */
 
 /* What a camera ray sees, as a number: the parts along its specular chain
  * (the transmitted branch through glass).  Sub-pixel samples with the same
  * signature see one smooth surface; differing ones mark an edge.  *first is
  * the ray's first hit. */
 static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, int steps, uint64_t *rays,
-                              hit *first)
+                              hit *first, int *curved)
 {
     uint32_t sig = 0x811c9dc5u;
     for (int k = 0; k <= steps; k++) {
@@ -37,6 +38,8 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, int steps, uin
             break;
         const rs_part *p = &rs->parts[h.part];
         const rs_object *m = &rs->objects[p->object];
+        if (p->shape == SHAPE_SPHERE)
+            *curved = 1;
         if (p->is_light || m->weight[LOBE_DIFFUSE] >= 1.0f)
             break;
         vec3f x = f3_madd(o, d, h.t);
@@ -102,6 +105,27 @@ static int push_lights(p2_row *row, const seen_lights *s)
     return 1;
 }
 
+/* Pushes pixel (px, py)'s g x g samples while they all have signature
+ * `first`; sets *edge when one does not, *curved when one meets a sphere.
+ * Returns 0 when out of memory. */
+static int grid_samples(const p2_ctx *c, int px, int py, int g, uint32_t first,
+                        seen_lights *lights, p2_row *row, uint64_t *rays, int *edge, int *curved)
+{
+    const rscene *rs = &c->r->rs;
+    vec3f org, dir;
+    hit h;
+    for (int sy = 0; sy < g; sy++)
+        for (int sx = 0; sx < g; sx++) {
+            cam_ray(&c->c, (float)px + (sx + 0.5f) / g, (float)py + (sy + 0.5f) / g, &org, &dir);
+            if (ray_signature(rs, org, dir, c->hi, rays, &h, curved) != first)
+                *edge = 1;
+            note_light(rs, lights, h.part);
+            if (!*edge && !push_sample(row, org, dir, h, 1.0 / (g * g)))
+                return 0;
+        }
+    return 1;
+}
+
 /* The samples of pixel (px, py) given its corner signatures. */
 static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners[4],
                          seen_lights *lights, p2_row *row, uint64_t *rays)
@@ -112,16 +136,17 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
     int edge = corners[1] != first || corners[2] != first || corners[3] != first;
     size_t start = row->sample_count;
     vec3f org, dir;
-    hit h;
-    for (int sy = 0; sy < g; sy++)
-        for (int sx = 0; sx < g; sx++) {
-            cam_ray(&c->c, (float)px + (sx + 0.5f) / g, (float)py + (sy + 0.5f) / g, &org, &dir);
-            if (ray_signature(rs, org, dir, hi, rays, &h) != first)
-                edge = 1;
-            note_light(rs, lights, h.part);
-            if (!edge && !push_sample(row, org, dir, h, 1.0 / (g * g)))
-                return 0;
-        }
+    int curved = 0;
+    if (!grid_samples(c, px, py, g, first, lights, row, rays, &edge, &curved))
+        return 0;
+    if (!edge && curved && g < CURVED_GRID) {
+        /* A sphere on the way: what the pixel sees (a reflection, a
+         * refraction, shading over a curved surface) changes within it
+         * faster than one sample can tell. */
+        row->sample_count = start;
+        if (!grid_samples(c, px, py, CURVED_GRID, first, lights, row, rays, &edge, &curved))
+            return 0;
+    }
     if (!edge)
         return 1;
     row->sample_count = start;
@@ -136,7 +161,8 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
         int sx = i % EDGE_GRID, sy = i / EDGE_GRID;
         cam_ray(&c->c, (float)px + (sx + 0.5f) / EDGE_GRID, (float)py + (sy + 0.5f) / EDGE_GRID,
                 &org, &dir);
-        sigs[i] = ray_signature(rs, org, dir, hi, rays, &hits[i]);
+        int curved_unused = 0;
+        sigs[i] = ray_signature(rs, org, dir, hi, rays, &hits[i], &curved_unused);
         note_light(rs, lights, hits[i].part);
         int k = 0;
         while (k < groups && group_sig[k] != sigs[i])
@@ -201,7 +227,8 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         vec3f org, dir;
         hit h;
         cam_ray(&c->c, (float)(k % w1), (float)(y + k / w1), &org, &dir);
-        row->corner[k] = ray_signature(rs, org, dir, c->hi, rays, &h);
+        int curved_unused = 0;
+        row->corner[k] = ray_signature(rs, org, dir, c->hi, rays, &h, &curved_unused);
         row->corner_part[k] = h.part;
     }
     for (int x = 0; x < w; x++) {
