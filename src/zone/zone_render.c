@@ -19,7 +19,7 @@ zone_quality zone_quality_for(const zt_scene *sc, int q)
     double extent = v3_length(v3_sub(hi, lo));
     double step = pow(sqrt(2.0), q);
     zone_quality z;
-    z.gather = 32 << q;
+    z.gather = 64 << q;
     z.texel_divisor = 20.0 * step;
     z.texel = extent / z.texel_divisor;
     z.max_texels = (int)(48.0 * step); /* a side, over the core */
