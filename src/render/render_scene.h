@@ -47,7 +47,7 @@ typedef struct rs_light {
 /* The infinite planes of one layer as arrays (one entry per plane, padded
  * to a multiple of PLANE_LANES with planes that are never hit), so that a
  * ray meets all of them in a few vector instructions. */
-#define PLANE_LANES 8
+#define PLANE_LANES 4
 typedef struct rs_planes {
     int count, padded;
     float *nx, *ny, *nz, *offset;
