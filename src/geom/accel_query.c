@@ -25,19 +25,21 @@ static inline f4 plane_block(const rs_planes *pl, int base, vec3f o, vec3f d)
     return f4_select(behind, f4_splat(-1.0f), (off - on) / dn);
 }
 
-static void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d, hit *h)
+/* Lowers *t and sets *part if a plane is hit nearer. */
+static inline void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d,
+                                  float *t, int *part)
 {
     const rs_planes *pl = &rs->planes[layer];
     for (int base = 0; base < pl->padded; base += PLANE_LANES) {
-        f4 t = plane_block(pl, base, o, d);
-        int bits = i4_bits((t > f4_splat(0.0f)) & (t < f4_splat(h->t)));
+        f4 tp = plane_block(pl, base, o, d);
+        int bits = i4_bits((tp > f4_splat(0.0f)) & (tp < f4_splat(*t)));
         /* The nearest lane, the first one on a tie, as a loop over the
          * planes in order would pick. */
         for (; bits; bits &= bits - 1) {
             int i = __builtin_ctz((unsigned)bits);
-            if (t[i] < h->t) {
-                h->t = t[i];
-                h->part = pl->part[base + i];
+            if (tp[i] < *t) {
+                *t = tp[i];
+                *part = pl->part[base + i];
             }
         }
     }
@@ -58,12 +60,19 @@ hit accel_intersect(const rscene *rs, vec3f o, vec3f d)
 {
     const accel *a = rs->accel;
     for (int layer = 0; layer < 2; layer++) {
-        hit h = {FLT_MAX, -1};
-        if (a->has_prims[layer])
+        /* The answer is built from locals, not from a struct the backend
+         * wrote: that read stalled on store forwarding. */
+        float t = FLT_MAX;
+        int part = -1;
+        if (a->has_prims[layer]) {
+            hit h = {FLT_MAX, -1};
             a->nearest(a, layer, o, d, &h);
-        planes_nearest(rs, layer, o, d, &h);
-        if (h.part >= 0)
-            return h;
+            t = h.t;
+            part = h.part;
+        }
+        planes_nearest(rs, layer, o, d, &t, &part);
+        if (part >= 0)
+            return (hit){t, part};
     }
     hit none = {FLT_MAX, -1};
     return none;
