@@ -1,5 +1,7 @@
 #include "material/bsdf.h"
 
+#include "util/sincos_turn.h"
+
 static vec3f reflect(vec3f wo, vec3f n)
 {
     return f3_sub(f3_scale(n, 2.0f * f3_dot(wo, n)), wo);
@@ -9,14 +11,14 @@ float bsdf_schlick(float cos_i, float ior)
 {
     float r0 = (1.0f - ior) / (1.0f + ior);
     r0 *= r0;
-    float m = 1.0f - fminf(fmaxf(cos_i, 0.0f), 1.0f);
+    float m = 1.0f - f_clamp01(cos_i);
     float m2 = m * m;
     return r0 + (1.0f - r0) * m2 * m2 * m;
 }
 
 float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t)
 {
-    cos_i = fminf(fmaxf(cos_i, 0.0f), 1.0f);
+    cos_i = f_clamp01(cos_i);
     float eta = eta_i / eta_t;
     float sin2_t = eta * eta * (1.0f - cos_i * cos_i);
     if (sin2_t >= 1.0f)
@@ -29,11 +31,12 @@ float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t)
 
 static vec3f cosine_hemisphere(vec3f n, const float u[2])
 {
-    float r = sqrtf(u[0]), phi = 2.0f * ZT_PI * u[1];
+    float r = sqrtf(u[0]), sin_phi, cos_phi;
+    sincos_turn(u[1], &sin_phi, &cos_phi);
     vec3f t, b;
     f3_basis(n, &t, &b);
-    float z = sqrtf(fmaxf(0.0f, 1.0f - u[0]));
-    return f3_add(f3_add(f3_scale(t, r * cosf(phi)), f3_scale(b, r * sinf(phi))),
+    float z = sqrtf(f_max0(1.0f - u[0]));
+    return f3_add(f3_add(f3_scale(t, r * cos_phi), f3_scale(b, r * sin_phi)),
                   f3_scale(n, z));
 }
 
@@ -61,7 +64,7 @@ int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
     switch (lobe) {
     case LOBE_DIFFUSE:
         out->wi = cosine_hemisphere(n, u2);
-        out->pdf = m->weight[LOBE_DIFFUSE] * f3_dot(n, out->wi) / ZT_PI;
+        out->pdf = m->weight[LOBE_DIFFUSE] * f3_dot(n, out->wi) * ZT_INV_PI;
         out->weight = m->color;
         return out->pdf > 0.0f;
     case LOBE_METALLIC:
@@ -81,7 +84,7 @@ int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
         }
         float eta = eta_i / eta_t;
         float sin2_t = eta * eta * (1.0f - cos_o * cos_o);
-        float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2_t));
+        float cos_t = sqrtf(f_max0(1.0f - sin2_t));
         out->wi = f3_normalize(f3_sub(f3_scale(f3_neg(wo), eta),
                                       f3_scale(n, cos_t - eta * cos_o)));
         /* Radiance is compressed entering a denser medium (L/eta^2 is
