@@ -117,7 +117,10 @@ typedef struct stack_entry {
     float entry;
 } stack_entry;
 
-/* Nearest hit below h->t (any = 0), or whether there is one (any = 1). */
+/* Nearest hit below h->t (any = 0), or whether there is one (any = 1).
+ * Always inlined, so each query gets its own copy with `any` a constant
+ * (GCC otherwise kept one copy testing it at run time). */
+__attribute__((always_inline))
 static inline int traverse(const bvh_tree *tr, vec3f o, vec3f d, hit *h,
                            int any)
 {
