@@ -88,24 +88,27 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
         vec3f wo = f3_neg(d);
         uint32_t pair = 1 + (uint32_t)(k - 1) * PAIRS_PER_VERTEX;
-        float u_light[2], u_dir[2], u_1d[4];
+        int nee = k >= pp->min_level && m->weight[LOBE_DIFFUSE] > 0.0f;
+        /* Numbers from the stream are drawn only where a choice needs
+         * them: most materials have one lobe, most scenes few lights. */
+        float u_light[2] = {0.0f, 0.0f}, u_dir[2];
         if (k <= STRATIFIED_VERTICES) {
             sampler_get2(key, index, pair, u_light);
             sampler_get2(key, index, pair + 1, u_dir);
         } else {
-            u_light[0] = sampler_next(&rng);
-            u_light[1] = sampler_next(&rng);
+            if (nee) {
+                u_light[0] = sampler_next(&rng);
+                u_light[1] = sampler_next(&rng);
+            }
             u_dir[0] = sampler_next(&rng);
             u_dir[1] = sampler_next(&rng);
         }
-        for (int j = 0; j < 4; j++)
-            u_1d[j] = sampler_next(&rng);
+        float u_select = nee && rs->light_count > 1 ? sampler_next(&rng) : 0.0f;
         vec3f x_out = ray_offset(x, n);
 
         /* Next-event estimation through the diffuse lobe. */
         light_sample ls;
-        if (k >= pp->min_level && m->weight[LOBE_DIFFUSE] > 0.0f &&
-            light_sample_point(rs, x, u_1d[0], u_light, &ls)) {
+        if (nee && light_sample_point(rs, x, u_select, u_light, &ls)) {
             float bsdf_pdf;
             vec3f fcos = bsdf_eval_diffuse(m, n, ls.wi, &bsdf_pdf);
             if (bsdf_pdf > 0.0f && !f3_is_black(ls.li)) {
@@ -131,8 +134,10 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         int entering = med.n == 0 || med.obj[med.n - 1] != p->object;
         float eta_i = medium_ior(rs, &med, 0);
         float eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
+        float u_lobe = m->lobe_choice ? sampler_next(&rng) : 0.0f;
+        float u_split = m->weight[LOBE_REFRACTIVE] > 0.0f ? sampler_next(&rng) : 0.0f;
         bsdf_sample bs;
-        if (!bsdf_sample_material(m, n, wo, u_1d[1], u_1d[2], u_dir,
+        if (!bsdf_sample_material(m, n, wo, u_lobe, u_split, u_dir,
                                   eta_i, eta_t, &bs))
             break;
         beta = f3_mul(beta, bs.weight);
@@ -159,7 +164,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
          * much, which keeps the estimate unbiased. */
         float q = f3_max(beta);
         if (k >= RR_START && q < 1.0f) {
-            if (u_1d[3] >= q)
+            if (sampler_next(&rng) >= q)
                 break;
             beta = f3_scale(beta, 1.0f / q);
         }

@@ -109,8 +109,12 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
     for (int i = 0; i < scene->object_count; i++) {
         const object *o = &scene->objects[i];
         rs_object *ro = &rs->objects[i];
-        for (int k = 0; k < LOBE_COUNT; k++)
+        int lobes = 0;
+        for (int k = 0; k < LOBE_COUNT; k++) {
             ro->weight[k] = (float)o->mat.weight[k];
+            lobes += ro->weight[k] > 0.0f;
+        }
+        ro->lobe_choice = lobes > 1;
         ro->color = to_f(o->mat.color);
         ro->ior = (float)o->mat.ior;
         ro->is_light = (uint8_t)o->is_light;

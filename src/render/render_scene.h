@@ -35,6 +35,8 @@ typedef struct rs_object {
     uint8_t is_light;
     uint8_t culled;
     uint8_t background;
+    uint8_t lobe_choice; /* more than one lobe has weight: choosing takes a
+                            random number */
 } rs_object;
 
 /* An emitting part that next-event estimation can sample. */
