@@ -32,10 +32,16 @@ typedef struct slab_ray {
     int near[3];       /* per axis, which corner the ray enters by */
 } slab_ray;
 
-static inline float inverse(float d)
+/* 1/d per component, in one vector division.  Finite for zero
+ * components, so 0 * inv never makes a NaN. */
+static inline vec3f inverse(vec3f d)
 {
-    /* Finite for zero components, so 0 * inv never makes a NaN. */
-    return 1.0f / (fabsf(d) > 1e-20f ? d : copysignf(1e-20f, d));
+    f4 v = {d.x, d.y, d.z, 1.0f};
+    f4 sign = (f4)((i4)v & (i4)f4_splat(-0.0f));
+    f4 tiny = (f4)((i4)f4_splat(1e-20f) | (i4)sign);
+    f4 mag = (f4)((i4)v & ~(i4)f4_splat(-0.0f));
+    f4 inv = f4_splat(1.0f) / f4_select(mag > f4_splat(1e-20f), v, tiny);
+    return f3(inv[0], inv[1], inv[2]);
 }
 
 static inline float fmin2(float a, float b) { return a < b ? a : b; }
@@ -126,7 +132,7 @@ static inline int traverse(const bvh_tree *tr, vec3f o, vec3f d, hit *h,
 {
     if (tr->node_count == 0)
         return 0;
-    slab_ray r = {o, f3(inverse(d.x), inverse(d.y), inverse(d.z)), {0}};
+    slab_ray r = {o, inverse(d), {0}};
     r.near[0] = r.inv.x < 0.0f;
     r.near[1] = r.inv.y < 0.0f;
     r.near[2] = r.inv.z < 0.0f;

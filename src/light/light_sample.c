@@ -12,15 +12,16 @@ vec3f light_emitted(const rscene *rs, const rs_part *p, vec3f y, vec3f d)
     return o->emission;
 }
 
+/* Binary search with the halves chosen by conditional moves: u is
+ * random, so a branch on it is mispredicted half the time. */
 static int pick_light(const rscene *rs, float u)
 {
     int lo = 0, hi = rs->light_count - 1;
     while (lo < hi) {
         int mid = (lo + hi) / 2;
-        if (u < rs->lights[mid].select_cdf)
-            hi = mid;
-        else
-            lo = mid + 1;
+        int below = u < rs->lights[mid].select_cdf;
+        hi = below ? mid : hi;
+        lo = below ? lo : mid + 1;
     }
     return lo;
 }
