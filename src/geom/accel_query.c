@@ -25,23 +25,23 @@ static inline f4 plane_block(const rs_planes *pl, int base, vec3f o, vec3f d)
     return f4_select(behind, f4_splat(-1.0f), (off - on) / dn);
 }
 
-/* Lowers *t and sets *part if a plane is hit nearer. */
+/* Lowers *t and sets *part if a plane is hit nearer: the nearest plane,
+ * the first one on a tie, as a loop over the planes in order would pick.
+ * Per block, the nearest lane is found with vector minima instead of a
+ * branch per lane (whose outcome is random: it was mispredicted). */
 static inline void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d,
                                   float *t, int *part)
 {
     const rs_planes *pl = &rs->planes[layer];
     for (int base = 0; base < pl->padded; base += PLANE_LANES) {
         f4 tp = plane_block(pl, base, o, d);
-        int bits = i4_bits((tp > f4_splat(0.0f)) & (tp < f4_splat(*t)));
-        /* The nearest lane, the first one on a tie, as a loop over the
-         * planes in order would pick. */
-        for (; bits; bits &= bits - 1) {
-            int i = __builtin_ctz((unsigned)bits);
-            if (tp[i] < *t) {
-                *t = tp[i];
-                *part = pl->part[base + i];
-            }
-        }
+        i4 valid = (tp > f4_splat(0.0f)) & (tp < f4_splat(*t));
+        if (!i4_bits(valid))
+            continue;
+        f4 near = f4_hmin(f4_select(valid, tp, f4_splat(INFINITY)));
+        int i = __builtin_ctz((unsigned)i4_bits(valid & (tp == near)));
+        *t = tp[i];
+        *part = pl->part[base + i];
     }
 }
 
