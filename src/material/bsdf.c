@@ -29,21 +29,20 @@ float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t)
     return 0.5f * (rs * rs + rp * rp);
 }
 
-static vec3f cosine_hemisphere(vec3f n, const float u[2])
+static vec3f cosine_hemisphere(const shading_frame *f, const float u[2])
 {
     float r = sqrtf(u[0]), sin_phi, cos_phi;
     sincos_turn(u[1], &sin_phi, &cos_phi);
-    vec3f t, b;
-    f3_basis(n, &t, &b);
     float z = sqrtf(f_max0(1.0f - u[0]));
-    return f3_add(f3_add(f3_scale(t, r * cos_phi), f3_scale(b, r * sin_phi)),
-                  f3_scale(n, z));
+    return f3_add(f3_add(f3_scale(f->t, r * cos_phi), f3_scale(f->b, r * sin_phi)),
+                  f3_scale(f->n, z));
 }
 
-int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
+int bsdf_sample_material(const rs_object *m, const shading_frame *f, vec3f wo, float u_lobe,
                          float u_split, const float u2[2], float eta_i,
                          float eta_t, bsdf_sample *out)
 {
+    vec3f n = f->n;
     /* Lobes are chosen with probability equal to their weights, so the
      * weights cancel from the throughput. */
     int lobe = LOBE_COUNT - 1;
@@ -63,7 +62,7 @@ int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
     out->pdf = 0.0f;
     switch (lobe) {
     case LOBE_DIFFUSE:
-        out->wi = cosine_hemisphere(n, u2);
+        out->wi = cosine_hemisphere(f, u2);
         out->pdf = m->weight[LOBE_DIFFUSE] * f3_dot(n, out->wi) * ZT_INV_PI;
         out->weight = m->color;
         return out->pdf > 0.0f;

@@ -12,6 +12,12 @@
  * latency on every vertex (the compiler may not do it by itself). */
 #define ZT_INV_PI 0.318309886183791f
 
+/* Where a material is sampled: n the normal facing wo's side, t and b
+ * completing an orthonormal frame (either handedness). */
+typedef struct shading_frame {
+    vec3f t, b, n;
+} shading_frame;
+
 typedef struct bsdf_sample {
     vec3f wi;       /* new direction, unit */
     vec3f weight;   /* f * |cos| / pdf: the throughput factor */
@@ -43,12 +49,12 @@ float bsdf_schlick(float cos_i, float ior);
  * eta_i into eta_t; 1 under total internal reflection. */
 float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t);
 
-/* Samples the material at a point with facing normal n (on the side of
+/* Samples the material at a point with frame f (f->n facing the side of
  * wo, the direction towards the previous vertex).  u_lobe picks the lobe,
  * u_split reflection or transmission of the dielectric, u2 the diffuse
  * direction.  eta_i/eta_t are the indices on wo's side and on the far
  * side.  Returns 0 when the sample carries no light. */
-int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
+int bsdf_sample_material(const rs_object *m, const shading_frame *f, vec3f wo, float u_lobe,
                          float u_split, const float u2[2], float eta_i,
                          float eta_t, bsdf_sample *out);
 

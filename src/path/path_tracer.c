@@ -136,8 +136,13 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         float eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
         float u_lobe = m->lobe_choice ? sampler_next(&rng) : 0.0f;
         float u_split = m->weight[LOBE_REFRACTIVE] > 0.0f ? sampler_next(&rng) : 0.0f;
+        /* Flat parts carry their frame; with n flipped, (t, b, n) is still
+         * orthonormal (left-handed), which the cosine lobe does not mind. */
+        shading_frame frame = {p->tangent, p->bitangent, n};
+        if (p->shape == SHAPE_SPHERE)
+            f3_basis(n, &frame.t, &frame.b);
         bsdf_sample bs;
-        if (!bsdf_sample_material(m, n, wo, u_lobe, u_split, u_dir,
+        if (!bsdf_sample_material(m, &frame, wo, u_lobe, u_split, u_dir,
                                   eta_i, eta_t, &bs))
             break;
         beta = f3_mul(beta, bs.weight);

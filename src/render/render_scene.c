@@ -48,6 +48,7 @@ static void fill_part(rs_part *rp, const part *p, const object *o)
         rp->e2 = to_f(e2);
         rp->n = to_f(v3_normalize(c));
         rp->area = (float)(0.5 * v3_length(c));
+        f3_basis(rp->n, &rp->tangent, &rp->bitangent);
         break;
     }
     case SHAPE_SPHERE:
@@ -57,6 +58,7 @@ static void fill_part(rs_part *rp, const part *p, const object *o)
     case SHAPE_PLANE:
         rp->n = to_f(p->normal);
         rp->offset = (float)p->offset;
+        f3_basis(rp->n, &rp->tangent, &rp->bitangent);
         break;
     default:
         break;

@@ -22,6 +22,8 @@ typedef struct rs_part {
     vec3f p0;           /* triangle vertex 0, sphere centre, point */
     vec3f e1, e2;       /* triangle edges p1-p0, p2-p0 */
     vec3f n;            /* triangle/plane unit normal (front side) */
+    vec3f tangent, bitangent; /* triangle/plane: f3_basis(n), precomputed
+                                 for sampling directions around n */
     float radius;       /* sphere */
     float offset;       /* plane: n.x = offset */
     float area;         /* triangle/sphere surface area */
