@@ -15,7 +15,7 @@
 typedef enum accel_kind {
     ACCEL_EMBREE = 0, /* Intel Embree 3 (default) */
     ACCEL_BRUTE = 1,  /* every primitive, every ray: the test oracle */
-    ACCEL_BVH = 2     /* the project's own binned-SAH BVH (accel_bvh.c) */
+    ACCEL_BVH = 2     /* the project's own four-wide SAH BVH (accel_bvh.c) */
 } accel_kind;
 
 /* Builds the structure for rs (rs->accel).  ZT_ERR_MEMORY or

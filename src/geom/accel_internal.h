@@ -11,6 +11,9 @@ typedef struct accel {
     /* Whether any primitive is hit in (0, tmax). */
     int (*any)(const struct accel *a, int layer, vec3f o, vec3f d, float tmax);
     void (*destroy)(struct accel *a);
+    /* Whether the layer has any primitives (set by accel_build): most
+     * scenes have only planes in one of them, and the call is skipped. */
+    int has_prims[2];
 } accel;
 
 zt_status accel_build_embree(rscene *rs, zt_error *err);

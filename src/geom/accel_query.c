@@ -2,58 +2,55 @@
 #include "geom/accel_internal.h"
 
 #include <float.h>
+#include <string.h>
 
 #include "geom/shapes.h"
+#include "util/simd4.h"
 
 /* Planes: t = (offset - n.o) / (n.d), valid in (0, tmax) and, for culled
- * planes, only from the front.  All planes of a layer are computed at once
- * in fixed-width blocks the compiler turns into vector code; a failed
- * division (n.d = 0) gives inf or nan, which compare false. */
-static inline void plane_block(const rs_planes *pl, int base, vec3f o, vec3f d,
-                               float *restrict t)
+ * planes, only from the front.  Four planes at a time in vector lanes; a
+ * failed division (n.d = 0) gives inf or nan, which compare false. */
+static inline f4 plane_block(const rs_planes *pl, int base, vec3f o, vec3f d)
 {
-    const float *restrict nx = pl->nx + base, *restrict ny = pl->ny + base;
-    const float *restrict nz = pl->nz + base, *restrict off = pl->offset + base;
-    const float *restrict cull = pl->culled + base;
-    for (int i = 0; i < PLANE_LANES; i++) {
-        float dn = d.x * nx[i] + d.y * ny[i] + d.z * nz[i];
-        float on = o.x * nx[i] + o.y * ny[i] + o.z * nz[i];
-        float ti = (off[i] - on) / dn;
-        /* Culled planes seen from behind: no hit.  Arithmetic instead of a
-         * branch keeps the loop vectorisable (inf/nan still compare false). */
-        float m = (float)((cull[i] > 0.0f) & (dn >= 0.0f));
-        t[i] = ti * (1.0f - m) - m;
-    }
+    f4 nx, ny, nz, off, cull;
+    memcpy(&nx, pl->nx + base, sizeof nx);
+    memcpy(&ny, pl->ny + base, sizeof ny);
+    memcpy(&nz, pl->nz + base, sizeof nz);
+    memcpy(&off, pl->offset + base, sizeof off);
+    memcpy(&cull, pl->culled + base, sizeof cull);
+    f4 dn = f4_splat(d.x) * nx + f4_splat(d.y) * ny + f4_splat(d.z) * nz;
+    f4 on = f4_splat(o.x) * nx + f4_splat(o.y) * ny + f4_splat(o.z) * nz;
+    /* Culled planes seen from behind: no hit. */
+    i4 behind = (cull > f4_splat(0.0f)) & (dn >= f4_splat(0.0f));
+    return f4_select(behind, f4_splat(-1.0f), (off - on) / dn);
 }
 
-static void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d, hit *h)
+/* Lowers *t and sets *part if a plane is hit nearer: the nearest plane,
+ * the first one on a tie, as a loop over the planes in order would pick.
+ * Per block, the nearest lane is found with vector minima instead of a
+ * branch per lane (whose outcome is random: it was mispredicted). */
+static inline void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d,
+                                  float *t, int *part)
 {
     const rs_planes *pl = &rs->planes[layer];
-    float t[PLANE_LANES];
-    float best = h->t;
-    int part = h->part;
     for (int base = 0; base < pl->padded; base += PLANE_LANES) {
-        plane_block(pl, base, o, d, t);
-        for (int i = 0; i < PLANE_LANES; i++) {
-            int better = t[i] > 0.0f && t[i] < best;
-            best = better ? t[i] : best;
-            part = better ? pl->part[base + i] : part;
-        }
+        f4 tp = plane_block(pl, base, o, d);
+        i4 valid = (tp > f4_splat(0.0f)) & (tp < f4_splat(*t));
+        if (!i4_bits(valid))
+            continue;
+        f4 near = f4_hmin(f4_select(valid, tp, f4_splat(INFINITY)));
+        int i = __builtin_ctz((unsigned)i4_bits(valid & (tp == near)));
+        *t = tp[i];
+        *part = pl->part[base + i];
     }
-    h->t = best;
-    h->part = part;
 }
 
 static int planes_any(const rscene *rs, int layer, vec3f o, vec3f d, float tmax)
 {
     const rs_planes *pl = &rs->planes[layer];
-    float t[PLANE_LANES];
     for (int base = 0; base < pl->padded; base += PLANE_LANES) {
-        plane_block(pl, base, o, d, t);
-        int any = 0;
-        for (int i = 0; i < PLANE_LANES; i++)
-            any |= t[i] > 0.0f && t[i] < tmax;
-        if (any)
+        f4 t = plane_block(pl, base, o, d);
+        if (i4_bits((t > f4_splat(0.0f)) & (t < f4_splat(tmax))))
             return 1;
     }
     return 0;
@@ -63,11 +60,19 @@ hit accel_intersect(const rscene *rs, vec3f o, vec3f d)
 {
     const accel *a = rs->accel;
     for (int layer = 0; layer < 2; layer++) {
-        hit h = {FLT_MAX, -1};
-        a->nearest(a, layer, o, d, &h);
-        planes_nearest(rs, layer, o, d, &h);
-        if (h.part >= 0)
-            return h;
+        /* The answer is built from locals, not from a struct the backend
+         * wrote: that read stalled on store forwarding. */
+        float t = FLT_MAX;
+        int part = -1;
+        if (a->has_prims[layer]) {
+            hit h = {FLT_MAX, -1};
+            a->nearest(a, layer, o, d, &h);
+            t = h.t;
+            part = h.part;
+        }
+        planes_nearest(rs, layer, o, d, &t, &part);
+        if (part >= 0)
+            return (hit){t, part};
     }
     hit none = {FLT_MAX, -1};
     return none;
@@ -78,10 +83,12 @@ int accel_occluded(const rscene *rs, vec3f o, vec3f d, float dist,
 {
     const accel *a = rs->accel;
     float fg_reach = target_is_background ? FLT_MAX : dist;
-    if (planes_any(rs, 0, o, d, fg_reach) || a->any(a, 0, o, d, fg_reach))
+    if (planes_any(rs, 0, o, d, fg_reach) ||
+        (a->has_prims[0] && a->any(a, 0, o, d, fg_reach)))
         return 1;
     if (target_is_background &&
-        (planes_any(rs, 1, o, d, dist) || a->any(a, 1, o, d, dist)))
+        (planes_any(rs, 1, o, d, dist) ||
+         (a->has_prims[1] && a->any(a, 1, o, d, dist))))
         return 1;
     return 0;
 }
@@ -95,10 +102,18 @@ void accel_free(struct accel *a)
 
 zt_status accel_build(rscene *rs, accel_kind kind, zt_error *err)
 {
+    zt_status st = ZT_ERR_ARGUMENT;
     switch (kind) {
-    case ACCEL_EMBREE: return accel_build_embree(rs, err);
-    case ACCEL_BRUTE: return accel_build_brute(rs, err);
-    case ACCEL_BVH: return accel_build_bvh(rs, err);
+    case ACCEL_EMBREE: st = accel_build_embree(rs, err); break;
+    case ACCEL_BRUTE: st = accel_build_brute(rs, err); break;
+    case ACCEL_BVH: st = accel_build_bvh(rs, err); break;
     }
-    return ZT_ERR_ARGUMENT;
+    if (st != ZT_OK)
+        return st;
+    for (int i = 0; i < rs->part_count; i++) {
+        const rs_part *p = &rs->parts[i];
+        if (p->shape == SHAPE_TRIANGLE || p->shape == SHAPE_SPHERE)
+            rs->accel->has_prims[p->background] = 1;
+    }
+    return ZT_OK;
 }

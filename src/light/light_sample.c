@@ -2,6 +2,7 @@
 
 #include "geom/shapes.h"
 #include "material/bsdf.h"
+#include "util/sincos_turn.h"
 
 vec3f light_emitted(const rscene *rs, const rs_part *p, vec3f y, vec3f d)
 {
@@ -11,15 +12,16 @@ vec3f light_emitted(const rscene *rs, const rs_part *p, vec3f y, vec3f d)
     return o->emission;
 }
 
+/* Binary search with the halves chosen by conditional moves: u is
+ * random, so a branch on it is mispredicted half the time. */
 static int pick_light(const rscene *rs, float u)
 {
     int lo = 0, hi = rs->light_count - 1;
     while (lo < hi) {
         int mid = (lo + hi) / 2;
-        if (u < rs->lights[mid].select_cdf)
-            hi = mid;
-        else
-            lo = mid + 1;
+        int below = u < rs->lights[mid].select_cdf;
+        hi = below ? mid : hi;
+        lo = below ? lo : mid + 1;
     }
     return lo;
 }
@@ -31,7 +33,7 @@ static float cone_one_minus_cos(float r, float dc)
     float s2 = (r / dc) * (r / dc);
     if (s2 < 1e-3f)
         return 0.5f * s2 + 0.125f * s2 * s2;
-    return 1.0f - sqrtf(fmaxf(0.0f, 1.0f - s2));
+    return 1.0f - sqrtf(f_max0(1.0f - s2));
 }
 
 /* Points the sample from x at the light point y; returns the squared
@@ -55,9 +57,10 @@ static int sample_sphere(const rs_part *p, vec3f x, const float u2[2],
     if (dc <= p->radius) {
         if (p->culled)
             return 0; /* inside a culled sphere: it is invisible */
-        float z = 1.0f - 2.0f * u2[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
-        float phi = 2.0f * ZT_PI * u2[1];
-        vec3f nrm = f3(r * cosf(phi), r * sinf(phi), z);
+        float z = 1.0f - 2.0f * u2[0], r = sqrtf(f_max0(1.0f - z * z));
+        float sin_phi, cos_phi;
+        sincos_turn(u2[1], &sin_phi, &cos_phi);
+        vec3f nrm = f3(r * cos_phi, r * sin_phi, z);
         float d2 = aim_at(x, f3_madd(p->p0, nrm, p->radius), out);
         if (d2 <= 0.0f)
             return 0;
@@ -69,18 +72,19 @@ static int sample_sphere(const rs_part *p, vec3f x, const float u2[2],
     }
     float omc = cone_one_minus_cos(p->radius, dc);
     float cos_t = 1.0f - u2[0] * omc;
-    float sin_t = sqrtf(fmaxf(0.0f, u2[0] * omc * (2.0f - u2[0] * omc)));
-    float phi = 2.0f * ZT_PI * u2[1];
+    float sin_t = sqrtf(f_max0(u2[0] * omc * (2.0f - u2[0] * omc)));
+    float sin_phi, cos_phi;
+    sincos_turn(u2[1], &sin_phi, &cos_phi);
     vec3f w = f3_scale(to_c, 1.0f / dc), t, b;
     f3_basis(w, &t, &b);
     out->wi = f3_normalize(f3_add(f3_scale(w, cos_t),
-                                  f3_add(f3_scale(t, sin_t * cosf(phi)),
-                                         f3_scale(b, sin_t * sinf(phi)))));
+                                  f3_add(f3_scale(t, sin_t * cos_phi),
+                                         f3_scale(b, sin_t * sin_phi))));
     /* Distance to the near side; at the rim the discriminant may round
      * below zero, where the tangent point is the answer. */
     float proj = dc * cos_t;
     float disc = p->radius * p->radius - dc * dc * sin_t * sin_t;
-    out->dist = proj - sqrtf(fmaxf(0.0f, disc));
+    out->dist = proj - sqrtf(f_max0(disc));
     out->pdf = 1.0f / (2.0f * ZT_PI * omc);
     return out->dist > 0.0f;
 }

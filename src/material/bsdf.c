@@ -1,5 +1,7 @@
 #include "material/bsdf.h"
 
+#include "util/sincos_turn.h"
+
 static vec3f reflect(vec3f wo, vec3f n)
 {
     return f3_sub(f3_scale(n, 2.0f * f3_dot(wo, n)), wo);
@@ -9,14 +11,14 @@ float bsdf_schlick(float cos_i, float ior)
 {
     float r0 = (1.0f - ior) / (1.0f + ior);
     r0 *= r0;
-    float m = 1.0f - fminf(fmaxf(cos_i, 0.0f), 1.0f);
+    float m = 1.0f - f_clamp01(cos_i);
     float m2 = m * m;
     return r0 + (1.0f - r0) * m2 * m2 * m;
 }
 
 float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t)
 {
-    cos_i = fminf(fmaxf(cos_i, 0.0f), 1.0f);
+    cos_i = f_clamp01(cos_i);
     float eta = eta_i / eta_t;
     float sin2_t = eta * eta * (1.0f - cos_i * cos_i);
     if (sin2_t >= 1.0f)
@@ -27,20 +29,20 @@ float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t)
     return 0.5f * (rs * rs + rp * rp);
 }
 
-static vec3f cosine_hemisphere(vec3f n, const float u[2])
+static vec3f cosine_hemisphere(const shading_frame *f, const float u[2])
 {
-    float r = sqrtf(u[0]), phi = 2.0f * ZT_PI * u[1];
-    vec3f t, b;
-    f3_basis(n, &t, &b);
-    float z = sqrtf(fmaxf(0.0f, 1.0f - u[0]));
-    return f3_add(f3_add(f3_scale(t, r * cosf(phi)), f3_scale(b, r * sinf(phi))),
-                  f3_scale(n, z));
+    float r = sqrtf(u[0]), sin_phi, cos_phi;
+    sincos_turn(u[1], &sin_phi, &cos_phi);
+    float z = sqrtf(f_max0(1.0f - u[0]));
+    return f3_add(f3_add(f3_scale(f->t, r * cos_phi), f3_scale(f->b, r * sin_phi)),
+                  f3_scale(f->n, z));
 }
 
-int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
+int bsdf_sample_material(const rs_object *m, const shading_frame *f, vec3f wo, float u_lobe,
                          float u_split, const float u2[2], float eta_i,
                          float eta_t, bsdf_sample *out)
 {
+    vec3f n = f->n;
     /* Lobes are chosen with probability equal to their weights, so the
      * weights cancel from the throughput. */
     int lobe = LOBE_COUNT - 1;
@@ -60,8 +62,8 @@ int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
     out->pdf = 0.0f;
     switch (lobe) {
     case LOBE_DIFFUSE:
-        out->wi = cosine_hemisphere(n, u2);
-        out->pdf = m->weight[LOBE_DIFFUSE] * f3_dot(n, out->wi) / ZT_PI;
+        out->wi = cosine_hemisphere(f, u2);
+        out->pdf = m->weight[LOBE_DIFFUSE] * f3_dot(n, out->wi) * ZT_INV_PI;
         out->weight = m->color;
         return out->pdf > 0.0f;
     case LOBE_METALLIC:
@@ -81,7 +83,7 @@ int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
         }
         float eta = eta_i / eta_t;
         float sin2_t = eta * eta * (1.0f - cos_o * cos_o);
-        float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2_t));
+        float cos_t = sqrtf(f_max0(1.0f - sin2_t));
         out->wi = f3_normalize(f3_sub(f3_scale(f3_neg(wo), eta),
                                       f3_scale(n, cos_t - eta * cos_o)));
         /* Radiance is compressed entering a denser medium (L/eta^2 is

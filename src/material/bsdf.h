@@ -8,6 +8,15 @@
 #include "render/render_scene.h"
 
 #define ZT_PI 3.14159265358979f
+/* Multiplying by it instead of dividing by ZT_PI saves a division's
+ * latency on every vertex (the compiler may not do it by itself). */
+#define ZT_INV_PI 0.318309886183791f
+
+/* Where a material is sampled: n the normal facing wo's side, t and b
+ * completing an orthonormal frame (either handedness). */
+typedef struct shading_frame {
+    vec3f t, b, n;
+} shading_frame;
 
 typedef struct bsdf_sample {
     vec3f wi;       /* new direction, unit */
@@ -28,8 +37,8 @@ static inline vec3f bsdf_eval_diffuse(const rs_object *m, vec3f n, vec3f wi,
         return f3_splat(0.0f);
     }
     float w = m->weight[LOBE_DIFFUSE];
-    *pdf = w * c / ZT_PI;
-    return f3_scale(m->color, w * c / ZT_PI);
+    *pdf = w * c * ZT_INV_PI;
+    return f3_scale(m->color, *pdf);
 }
 
 /* Schlick's Fresnel with R0 from the index, as the original programs
@@ -40,12 +49,12 @@ float bsdf_schlick(float cos_i, float ior);
  * eta_i into eta_t; 1 under total internal reflection. */
 float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t);
 
-/* Samples the material at a point with facing normal n (on the side of
+/* Samples the material at a point with frame f (f->n facing the side of
  * wo, the direction towards the previous vertex).  u_lobe picks the lobe,
  * u_split reflection or transmission of the dielectric, u2 the diffuse
  * direction.  eta_i/eta_t are the indices on wo's side and on the far
  * side.  Returns 0 when the sample carries no light. */
-int bsdf_sample_material(const rs_object *m, vec3f n, vec3f wo, float u_lobe,
+int bsdf_sample_material(const rs_object *m, const shading_frame *f, vec3f wo, float u_lobe,
                          float u_split, const float u2[2], float eta_i,
                          float eta_t, bsdf_sample *out);
 

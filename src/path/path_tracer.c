@@ -28,6 +28,12 @@ static inline float power_heuristic(float a, float b)
     return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
 }
 
+/* power_heuristic(a, b) / a for a > 0: one division instead of two. */
+static inline float power_heuristic_over(float a, float b)
+{
+    return a / (a * a + b * b);
+}
+
 /* The refractive objects the path is inside, innermost last: deciding
  * entering/leaving by object identity makes shells of two surfaces work. */
 typedef struct media {
@@ -82,24 +88,27 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
         vec3f wo = f3_neg(d);
         uint32_t pair = 1 + (uint32_t)(k - 1) * PAIRS_PER_VERTEX;
-        float u_light[2], u_dir[2], u_1d[4];
+        int nee = k >= pp->min_level && m->weight[LOBE_DIFFUSE] > 0.0f;
+        /* Numbers from the stream are drawn only where a choice needs
+         * them: most materials have one lobe, most scenes few lights. */
+        float u_light[2] = {0.0f, 0.0f}, u_dir[2];
         if (k <= STRATIFIED_VERTICES) {
             sampler_get2(key, index, pair, u_light);
             sampler_get2(key, index, pair + 1, u_dir);
         } else {
-            u_light[0] = sampler_next(&rng);
-            u_light[1] = sampler_next(&rng);
+            if (nee) {
+                u_light[0] = sampler_next(&rng);
+                u_light[1] = sampler_next(&rng);
+            }
             u_dir[0] = sampler_next(&rng);
             u_dir[1] = sampler_next(&rng);
         }
-        for (int j = 0; j < 4; j++)
-            u_1d[j] = sampler_next(&rng);
+        float u_select = nee && rs->light_count > 1 ? sampler_next(&rng) : 0.0f;
         vec3f x_out = ray_offset(x, n);
 
         /* Next-event estimation through the diffuse lobe. */
         light_sample ls;
-        if (k >= pp->min_level && m->weight[LOBE_DIFFUSE] > 0.0f &&
-            light_sample_point(rs, x, u_1d[0], u_light, &ls)) {
+        if (nee && light_sample_point(rs, x, u_select, u_light, &ls)) {
             float bsdf_pdf;
             vec3f fcos = bsdf_eval_diffuse(m, n, ls.wi, &bsdf_pdf);
             if (bsdf_pdf > 0.0f && !f3_is_black(ls.li)) {
@@ -113,9 +122,10 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 float dist_y = f3_length(to_y);
                 vec3f dir_y = f3_scale(to_y, 1.0f / dist_y);
                 if (!accel_occluded(rs, x_out, dir_y, dist_y * 0.9999f, lp->background)) {
-                    float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
+                    float w_over_pdf = ls.delta ? 1.0f / ls.pdf
+                                                : power_heuristic_over(ls.pdf, bsdf_pdf);
                     radiance = f3_add(radiance,
-                                      f3_scale(f3_mul(f3_mul(beta, fcos), ls.li), w / ls.pdf));
+                                      f3_scale(f3_mul(f3_mul(beta, fcos), ls.li), w_over_pdf));
                 }
             }
         }
@@ -124,8 +134,15 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         int entering = med.n == 0 || med.obj[med.n - 1] != p->object;
         float eta_i = medium_ior(rs, &med, 0);
         float eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
+        float u_lobe = m->lobe_choice ? sampler_next(&rng) : 0.0f;
+        float u_split = m->weight[LOBE_REFRACTIVE] > 0.0f ? sampler_next(&rng) : 0.0f;
+        /* Flat parts carry their frame; with n flipped, (t, b, n) is still
+         * orthonormal (left-handed), which the cosine lobe does not mind. */
+        shading_frame frame = {p->tangent, p->bitangent, n};
+        if (p->shape == SHAPE_SPHERE)
+            f3_basis(n, &frame.t, &frame.b);
         bsdf_sample bs;
-        if (!bsdf_sample_material(m, n, wo, u_1d[1], u_1d[2], u_dir,
+        if (!bsdf_sample_material(m, &frame, wo, u_lobe, u_split, u_dir,
                                   eta_i, eta_t, &bs))
             break;
         beta = f3_mul(beta, bs.weight);
@@ -152,7 +169,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
          * much, which keeps the estimate unbiased. */
         float q = f3_max(beta);
         if (k >= RR_START && q < 1.0f) {
-            if (u_1d[3] >= q)
+            if (sampler_next(&rng) >= q)
                 break;
             beta = f3_scale(beta, 1.0f / q);
         }

@@ -48,6 +48,7 @@ static void fill_part(rs_part *rp, const part *p, const object *o)
         rp->e2 = to_f(e2);
         rp->n = to_f(v3_normalize(c));
         rp->area = (float)(0.5 * v3_length(c));
+        f3_basis(rp->n, &rp->tangent, &rp->bitangent);
         break;
     }
     case SHAPE_SPHERE:
@@ -57,6 +58,7 @@ static void fill_part(rs_part *rp, const part *p, const object *o)
     case SHAPE_PLANE:
         rp->n = to_f(p->normal);
         rp->offset = (float)p->offset;
+        f3_basis(rp->n, &rp->tangent, &rp->bitangent);
         break;
     default:
         break;
@@ -109,8 +111,12 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
     for (int i = 0; i < scene->object_count; i++) {
         const object *o = &scene->objects[i];
         rs_object *ro = &rs->objects[i];
-        for (int k = 0; k < LOBE_COUNT; k++)
+        int lobes = 0;
+        for (int k = 0; k < LOBE_COUNT; k++) {
             ro->weight[k] = (float)o->mat.weight[k];
+            lobes += ro->weight[k] > 0.0f;
+        }
+        ro->lobe_choice = lobes > 1;
         ro->color = to_f(o->mat.color);
         ro->ior = (float)o->mat.ior;
         ro->is_light = (uint8_t)o->is_light;

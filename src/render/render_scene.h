@@ -22,6 +22,8 @@ typedef struct rs_part {
     vec3f p0;           /* triangle vertex 0, sphere centre, point */
     vec3f e1, e2;       /* triangle edges p1-p0, p2-p0 */
     vec3f n;            /* triangle/plane unit normal (front side) */
+    vec3f tangent, bitangent; /* triangle/plane: f3_basis(n), precomputed
+                                 for sampling directions around n */
     float radius;       /* sphere */
     float offset;       /* plane: n.x = offset */
     float area;         /* triangle/sphere surface area */
@@ -35,6 +37,8 @@ typedef struct rs_object {
     uint8_t is_light;
     uint8_t culled;
     uint8_t background;
+    uint8_t lobe_choice; /* more than one lobe has weight: choosing takes a
+                            random number */
 } rs_object;
 
 /* An emitting part that next-event estimation can sample. */
@@ -47,7 +51,7 @@ typedef struct rs_light {
 /* The infinite planes of one layer as arrays (one entry per plane, padded
  * to a multiple of PLANE_LANES with planes that are never hit), so that a
  * ray meets all of them in a few vector instructions. */
-#define PLANE_LANES 8
+#define PLANE_LANES 4
 typedef struct rs_planes {
     int count, padded;
     float *nx, *ny, *nz, *offset;

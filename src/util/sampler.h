@@ -55,14 +55,16 @@ static inline uint32_t sampler_owen(uint32_t x, uint32_t seed)
     return sampler_reverse_bits(sampler_lk_permute(sampler_reverse_bits(x), seed));
 }
 
-/* Second Sobol dimension (the first is the bit-reversed index): the XOR of
- * the generator matrix columns of the index's set bits (by table). */
-static inline uint32_t sampler_sobol1(uint32_t index)
+/* Second Sobol dimension (the first is the bit-reversed index), with its
+ * bits reversed: the XOR of the generator matrix columns of the index's
+ * set bits, by a table of reversed columns (which saves the reversal the
+ * scramble would start with). */
+static inline uint32_t sampler_sobol1_reversed(uint32_t index)
 {
-    return sampler_sobol1_bytes[0][index & 255U] ^
-           sampler_sobol1_bytes[1][(index >> 8) & 255U] ^
-           sampler_sobol1_bytes[2][(index >> 16) & 255U] ^
-           sampler_sobol1_bytes[3][index >> 24];
+    return sampler_sobol1_reversed_bytes[0][index & 255U] ^
+           sampler_sobol1_reversed_bytes[1][(index >> 8) & 255U] ^
+           sampler_sobol1_reversed_bytes[2][(index >> 16) & 255U] ^
+           sampler_sobol1_reversed_bytes[3][index >> 24];
 }
 
 static inline float sampler_to_float(uint32_t x)
@@ -81,7 +83,8 @@ static inline void sampler_get2(uint32_t key, uint32_t index, uint32_t pair,
     uint32_t i = sampler_owen(index, h) & 0xfffffU;
     /* Dimension 0 is reverse_bits(i), so its scramble needs one reversal. */
     out[0] = sampler_to_float(sampler_reverse_bits(sampler_lk_permute(i, h * 0x9e3779b9U + 1U)));
-    out[1] = sampler_to_float(sampler_owen(sampler_sobol1(i), h * 0x85ebca6bU + 2U));
+    out[1] = sampler_to_float(sampler_reverse_bits(
+        sampler_lk_permute(sampler_sobol1_reversed(i), h * 0x85ebca6bU + 2U)));
 }
 
 /* A small per-sample random stream (PCG32's RXS-M-XS output on an LCG) for

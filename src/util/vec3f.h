@@ -24,7 +24,17 @@ static inline vec3f f3_normalize(vec3f a)
     float l = f3_length(a);
     return l > 0.0f ? f3_scale(a, 1.0f / l) : a;
 }
-static inline float f3_max(vec3f a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
+/* max(x, 0), min(max(x, 0), 1) and the largest component as comparisons,
+ * which the compiler inlines: fmaxf is a library call without
+ * -ffast-math, and a call in the hot loop spills every float register.
+ * NaN gives 0 in the first two, as with fmaxf. */
+static inline float f_max0(float x) { return x > 0.0f ? x : 0.0f; }
+static inline float f_clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
+static inline float f3_max(vec3f a)
+{
+    float m = a.x > a.y ? a.x : a.y;
+    return m > a.z ? m : a.z;
+}
 static inline float f3_luminance(vec3f a) { return 0.2126f * a.x + 0.7152f * a.y + 0.0722f * a.z; }
 static inline int f3_is_black(vec3f a) { return a.x <= 0.0f && a.y <= 0.0f && a.z <= 0.0f; }
 static inline vec3f f3_madd(vec3f a, vec3f b, float s) { return f3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s); }
