@@ -399,9 +399,11 @@ static vec3 sky_texel(zone_trace *t, const zone_forest *f, vec3 x, vec3 n, const
     return v3_scale(v3(rs->sky.x, rs->sky.y, rs->sky.z), 3.14159265358979 * open / f->q.gather);
 }
 
-/* How many times wider texel (u, j) is than the core's texels.  A texel
- * far out on a plane stands for a large area seen from far away: its
- * transfer may be as coarse, relative to its distance, as it is wide. */
+/* How much coarser the transfer into texel (u, j) may be: the square root
+ * of how many times wider it is than the core's texels.  A texel far out on
+ * a plane stands for a large area that matters little; the full width
+ * ratio measured 3.5% instead of 3.0% at level 3 of the Cornell box, the
+ * square root 3.1%, and demo's Phase One 5.3 s, 6.6 s (30-90 s without). */
 static double texel_growth(const part_map *m, int u, int j)
 {
     const map_layout *l = &m->layout;
@@ -409,7 +411,7 @@ static double texel_growth(const part_map *m, int u, int j)
         return 1.0;
     double gu = (axis_edge(&l->au, u + 1) - axis_edge(&l->au, u)) * l->au.len / l->au.w;
     double gv = (axis_edge(&l->av, j + 1) - axis_edge(&l->av, j)) * l->av.len / l->av.w;
-    return fmax(1.0, fmax(gu, gv));
+    return sqrt(fmax(1.0, fmax(gu, gv)));
 }
 
 /* Where texel (u, j) of a map is lit: its centre, or for a texel cut by
