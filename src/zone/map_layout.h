@@ -1,0 +1,13 @@
+/* The layout of a part's map (zone_maps.h) made from the scene. */
+#ifndef ZT_ZONE_MAP_LAYOUT_H
+#define ZT_ZONE_MAP_LAYOUT_H
+
+#include "zone/zone_maps.h"
+
+/* Lays part i out: texels of about `texel` (at most max_texels a side over
+ * the scene's core [lo, hi]); for planes and triangles, the half-planes
+ * that bound the surface that exists (clip_n, clip_d). */
+void map_layout_part(const zt_scene *sc, int i, vec3 lo, vec3 hi, double texel, int max_texels,
+                     map_layout *l);
+
+#endif
