@@ -42,7 +42,7 @@ static void render_usage(FILE *f)
 "\n"
 "Zone tracer:\n"
 "      --strategy S      pixel (default) or zone\n"
-"      --cutoff X        prune zones whose power bound is below X (default 0)\n"
+"      --cutoff X        prune zones whose power bound is at most X (default 0)\n"
 "      --quality Q       discretisation level, higher is finer (default 2)\n"
 "      --save-forest FILE\n"
 "                        write the forest (Phase One: zones, occluder lists,\n"
