@@ -14,7 +14,6 @@
 #include <unistd.h>
 
 #include "util/error.h"
-#include "zone/transfer.h"
 
 static const char MAGIC[8] = {'Z', 'T', 'F', 'O', 'R', 'E', 'S', 'T'};
 #define BYTE_ORDER_MARK 0x01020304u

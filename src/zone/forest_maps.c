@@ -308,25 +308,32 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
     forest_scene_bounds(sc, &lo, &hi);
     /* Planes are mapped far beyond this core (plane_layout): open rooms
      * (the Cornell box has no front wall) send light out that comes back. */
+    map_walls walls = {malloc(((size_t)sc->part_count + 1) * sizeof(int)), 0};
+    if (!walls.part)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
+    walls.count = map_layout_walls(sc, walls.part);
     for (int i = 0; i < sc->part_count; i++) {
         const object *o = &sc->objects[sc->parts[i].object];
         if (o->is_light || o->mat.weight[LOBE_DIFFUSE] <= 0)
             continue;
         part_map *m = &f->maps[i];
-        map_layout_part(sc, i, lo, hi, f->q.texel, f->q.max_texels, &m->layout);
+        map_layout_part(sc, &walls, i, lo, hi, f->q.texel, f->q.max_texels, &m->layout);
         m->levels = f->map_levels + (f->sky_slot >= 0);
         size_t n = (size_t)m->levels * (size_t)m->layout.sides * (size_t)m->layout.nu *
                    (size_t)m->layout.nv * 3;
         m->texels = calloc(n, sizeof(float));
         m->weight[0] = calloc((size_t)m->layout.sides * m->layout.nu * m->layout.nv, sizeof(float));
-        if (!m->texels || !m->weight[0] || !map_layout_cache(&m->layout) || !map_build_cover(m))
+        if (!m->texels || !m->weight[0] || !map_layout_cache(&m->layout) || !map_build_cover(m)) {
+            free(walls.part);
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
+        }
     }
+    free(walls.part);
     f->blockers = transfer_blockers_build(sc);
     vec3 *dirs = gather_directions(f->q.gather);
+    f->dirs = dirs;
     if (!dirs || !f->blockers)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
-    f->dirs = dirs;
     /* Gathers are needed for what transfer does not cover: light arriving
      * from specular surfaces or diffuse spheres. */
     f->need_gather = 0;

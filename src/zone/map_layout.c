@@ -19,16 +19,14 @@ static int clampi(double v, int lo, int hi)
 #define OUTER_REACH 64.0
 
 /* Whether no light can reach the open half-space behind plane part q: q
- * hides what is behind it (culled, opaque, and not a background plane in
- * front of a foreground surface p), and every light lies in front of it. */
-static int walls_off(const zt_scene *sc, int q, int p)
+ * hides what is behind it (culled and opaque) and every light lies in
+ * front of it. */
+static int walls_off(const zt_scene *sc, int q)
 {
     const part *pq = &sc->parts[q];
     const object *oq = &sc->objects[pq->object];
     if (pq->shape != SHAPE_PLANE || !oq->backculled || oq->is_light ||
         oq->mat.weight[LOBE_REFRACTIVE] > 0 || (sc->sky.x > 0 || sc->sky.y > 0 || sc->sky.z > 0))
-        return 0;
-    if (oq->background && !sc->objects[sc->parts[p].object].background)
         return 0;
     for (int i = 0; i < sc->part_count; i++) {
         const part *l = &sc->parts[i];
@@ -56,14 +54,26 @@ static int walls_off(const zt_scene *sc, int q, int p)
     return 1;
 }
 
-/* The room planar part p lies in: the half-planes of the other planes that
- * no light can get behind, as clips of the layout (after those it has). */
-static void room_clips(const zt_scene *sc, int p, vec3 pn, map_layout *l)
+int map_layout_walls(const zt_scene *sc, int *walls)
 {
-    for (int q = 0; q < sc->part_count && l->clips < MAP_CLIPS; q++) {
-        if (q == p || !walls_off(sc, q, p))
-            continue;
+    int count = 0;
+    for (int q = 0; q < sc->part_count; q++)
+        if (walls_off(sc, q))
+            walls[count++] = q;
+    return count;
+}
+
+/* The room planar part p lies in: the half-planes of the walls, as clips
+ * of the layout (after those it has).  A background wall does not hide a
+ * foreground surface behind it (it is drawn behind everything). */
+static void room_clips(const zt_scene *sc, const map_walls *w, int p, vec3 pn, map_layout *l)
+{
+    int fore = !sc->objects[sc->parts[p].object].background;
+    for (int k = 0; k < w->count && l->clips < MAP_CLIPS; k++) {
+        int q = w->part[k];
         const part *pq = &sc->parts[q];
+        if (q == p || (fore && sc->objects[pq->object].background))
+            continue;
         if (fabs(v3_dot(pq->normal, pn)) > 1.0 - 1e-9)
             continue; /* parallel: all of p is on one side */
         l->clip_n[l->clips] = pq->normal;
@@ -78,7 +88,7 @@ static void room_clips(const zt_scene *sc, int p, vec3 pn, map_layout *l)
 static map_axis axis_build(double d0, double d1, double c0, double c1, double texel,
                            int max, double *start)
 {
-    map_axis a;
+    map_axis a = {0};
     a.r = OUTER_GROWTH;
     int core = (int)ceil((c1 - c0) / texel);
     core = core < 1 ? 1 : core > max ? max : core;
@@ -88,8 +98,7 @@ static map_axis axis_build(double d0, double d1, double c0, double c1, double te
     double k = (a.r - 1.0) / (a.w * a.r);
     int ml = left > 1e-6 * a.w ? (int)ceil(log1p(left * k) / log(a.r) - 1e-9) : 0;
     int mr = right > 1e-6 * a.w ? (int)ceil(log1p(right * k) / log(a.r) - 1e-9) : 0;
-    double span_l = a.w * a.r * (pow(a.r, ml) - 1.0) / (a.r - 1.0);
-    double span_r = a.w * a.r * (pow(a.r, mr) - 1.0) / (a.r - 1.0);
+    double span_l = axis_outer_span(&a, ml), span_r = axis_outer_span(&a, mr);
     a.k0 = ml;
     a.k1 = ml + core;
     a.n = a.k1 + mr;
@@ -98,7 +107,7 @@ static map_axis axis_build(double d0, double d1, double c0, double c1, double te
     return a;
 }
 
-static void plane_layout(const zt_scene *sc, int index, vec3 lo, vec3 hi, double texel,
+static void plane_layout(const zt_scene *sc, const map_walls *w, int index, vec3 lo, vec3 hi, double texel,
                          int max_texels, map_layout *l)
 {
     const part *p = &sc->parts[index];
@@ -106,7 +115,7 @@ static void plane_layout(const zt_scene *sc, int index, vec3 lo, vec3 hi, double
     vec3 a = fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0);
     vec3 u = v3_normalize(v3_cross(a, n)), v = v3_cross(n, u);
     vec3 base = v3_scale(n, p->offset);
-    room_clips(sc, index, n, l);
+    room_clips(sc, w, index, n, l);
     /* The mapped domain: a square reaching far around the core, clipped to
      * the room, in plane coordinates (x along u, y along v). */
     vec3 mid = v3_sub(v3_scale(v3_add(lo, hi), 0.5), base);
@@ -152,8 +161,8 @@ static void plane_layout(const zt_scene *sc, int index, vec3 lo, vec3 hi, double
     l->nv = l->av.n;
 }
 
-void map_layout_part(const zt_scene *sc, int i, vec3 lo, vec3 hi, double texel, int max_texels,
-                     map_layout *l)
+void map_layout_part(const zt_scene *sc, const map_walls *w, int i, vec3 lo, vec3 hi,
+                     double texel, int max_texels, map_layout *l)
 {
     const part *p = &sc->parts[i];
     memset(l, 0, sizeof *l);
@@ -176,7 +185,7 @@ void map_layout_part(const zt_scene *sc, int i, vec3 lo, vec3 hi, double texel, 
         l->clip_n[0] = v3_scale(mdir, -1);
         l->clip_d[0] = v3_dot(mdir, p->p[1]);
         l->clips = 1;
-        room_clips(sc, i, v3_normalize(nrm), l);
+        room_clips(sc, w, i, v3_normalize(nrm), l);
     } else if (p->shape == SHAPE_SPHERE) {
         l->centre = p->p[0];
         l->radius = p->radius;
@@ -185,7 +194,7 @@ void map_layout_part(const zt_scene *sc, int i, vec3 lo, vec3 hi, double texel, 
         l->au = axis_uniform(l->nu, 1.0);
         l->av = axis_uniform(l->nv, 1.0);
     } else {
-        plane_layout(sc, i, lo, hi, texel, max_texels, l);
+        plane_layout(sc, w, i, lo, hi, texel, max_texels, l);
     }
 }
 

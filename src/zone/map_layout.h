@@ -4,10 +4,20 @@
 
 #include "zone/zone_maps.h"
 
+/* The scene's walls: planes no light can get behind (back-culled, opaque,
+ * every light in front, a black sky), which bound the other surfaces. */
+typedef struct map_walls {
+    int *part;
+    int count;
+} map_walls;
+
+/* Finds the walls into walls[] (room for every part); returns their count. */
+int map_layout_walls(const zt_scene *sc, int *walls);
+
 /* Lays part i out: texels of about `texel` (at most max_texels a side over
  * the scene's core [lo, hi]); for planes and triangles, the half-planes
  * that bound the surface that exists (clip_n, clip_d). */
-void map_layout_part(const zt_scene *sc, int i, vec3 lo, vec3 hi, double texel, int max_texels,
-                     map_layout *l);
+void map_layout_part(const zt_scene *sc, const map_walls *w, int i, vec3 lo, vec3 hi,
+                     double texel, int max_texels, map_layout *l);
 
 #endif

@@ -23,7 +23,8 @@
 /* What a camera ray sees, as a number: the parts along its specular chain
  * (the transmitted branch through glass).  Sub-pixel samples with the same
  * signature see one smooth surface; differing ones mark an edge.  *first is
- * the ray's first hit. */
+ * the ray's first hit; *curved (unless NULL) is set when the chain meets a
+ * sphere. */
 static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, int steps, uint64_t *rays,
                               hit *first, int *curved)
 {
@@ -38,7 +39,7 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, int steps, uin
             break;
         const rs_part *p = &rs->parts[h.part];
         const rs_object *m = &rs->objects[p->object];
-        if (p->shape == SHAPE_SPHERE)
+        if (curved && p->shape == SHAPE_SPHERE)
             *curved = 1;
         if (p->is_light || m->weight[LOBE_DIFFUSE] >= 1.0f)
             break;
@@ -161,8 +162,7 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
         int sx = i % EDGE_GRID, sy = i / EDGE_GRID;
         cam_ray(&c->c, (float)px + (sx + 0.5f) / EDGE_GRID, (float)py + (sy + 0.5f) / EDGE_GRID,
                 &org, &dir);
-        int curved_unused = 0;
-        sigs[i] = ray_signature(rs, org, dir, hi, rays, &hits[i], &curved_unused);
+        sigs[i] = ray_signature(rs, org, dir, hi, rays, &hits[i], NULL);
         note_light(rs, lights, hits[i].part);
         int k = 0;
         while (k < groups && group_sig[k] != sigs[i])
@@ -227,8 +227,7 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         vec3f org, dir;
         hit h;
         cam_ray(&c->c, (float)(k % w1), (float)(y + k / w1), &org, &dir);
-        int curved_unused = 0;
-        row->corner[k] = ray_signature(rs, org, dir, c->hi, rays, &h, &curved_unused);
+        row->corner[k] = ray_signature(rs, org, dir, c->hi, rays, &h, NULL);
         row->corner_part[k] = h.part;
     }
     for (int x = 0; x < w; x++) {

@@ -227,8 +227,8 @@ static int maybe_blocked(const transfer_blockers *b, int receiver, int source, v
 
 typedef struct source {
     const part_map *m;
-    const part *p;
-    int index, level, side, background;
+    int index, level, side;
+    int background;    /* its flag, for visibility rays */
     vec3 scale;        /* w_d * rho / pi: radiance per irradiance */
 } source;
 
@@ -237,19 +237,17 @@ typedef struct receiver {
     vec3 x, n;
     vec3f origin;      /* x moved off its surface */
     double theta;
-    int background;    /* the source's flag, for visibility rays */
     int part;
 } receiver;
 
-
-/* Whether the receiver sees point c (a ray short of it). */
-static int sees(const receiver *r, vec3 c)
+/* Whether the receiver sees point c of the source (a ray short of it). */
+static int sees(const receiver *r, const source *src, vec3 c)
 {
     vec3f d = f3_sub(f3((float)c.x, (float)c.y, (float)c.z), r->origin);
     float len = f3_length(d);
     r->t->rays++;
     return len > 0 && !accel_occluded(&r->t->r->rs, r->origin, f3_scale(d, 1.0f / len),
-                                      len * 0.999f, r->background);
+                                      len * 0.999f, src->background);
 }
 
 /* Whether the receiver sees polygon q (n corners): with no ray when nothing
@@ -264,7 +262,7 @@ static int seen(const receiver *r, const source *src, const vec3 *q, int n)
     vec3 c = v3(0, 0, 0);
     for (int i = 0; i < n; i++)
         c = v3_add(c, q[i]);
-    return sees(r, v3_scale(c, 1.0 / n));
+    return sees(r, src, v3_scale(c, 1.0 / n));
 }
 
 static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, int j1);
@@ -324,7 +322,7 @@ vec3 transfer_irradiance(zone_trace *t, int receiver_part, vec3 x, vec3 n, int l
 {
     const zone_forest *f = t->f;
     const zt_scene *sc = t->r->scene;
-    receiver r = {t, x, n, f3(0, 0, 0), theta, 0, receiver_part};
+    receiver r = {t, x, n, f3(0, 0, 0), theta, receiver_part};
     r.origin = ray_offset(f3((float)x.x, (float)x.y, (float)x.z),
                           f3((float)n.x, (float)n.y, (float)n.z));
     vec3 e = v3(0, 0, 0);
@@ -339,9 +337,8 @@ vec3 transfer_irradiance(zone_trace *t, int receiver_part, vec3 x, vec3 n, int l
         int side = side_dist > 0 ? 0 : 1;
         if (side >= m->layout.sides || side_dist == 0)
             continue;
-        source src = {m, p, i, level - 1, side, o->background,
+        source src = {m, i, level - 1, side, o->background,
                       v3_scale(o->mat.color, o->mat.weight[LOBE_DIFFUSE] / 3.14159265358979)};
-        r.background = o->background;
         e = v3_add(e, piece(&r, &src, 0, 0, m->layout.nu, m->layout.nv));
     }
     return e;

@@ -10,22 +10,20 @@ map_axis axis_uniform(int n, double len)
     return a;
 }
 
-/* Total width of the m texels just outside the core: w r + w r^2 + ... */
-static double outer_span(const map_axis *a, double m)
+double axis_outer_span(const map_axis *a, int m)
 {
-    return a->w * a->r * (pow(a->r, m) - 1.0) / (a->r - 1.0);
+    return m > 0 ? a->w * a->r * (pow(a->r, m) - 1.0) / (a->r - 1.0) : 0.0;
 }
 
 static double edge_formula(const map_axis *a, int i)
 {
-    double x;
+    double c0 = axis_outer_span(a, a->k0), x;
     if (i < a->k0)
-        x = outer_span(a, a->k0) - outer_span(a, a->k0 - i);
+        x = c0 - axis_outer_span(a, a->k0 - i);
     else if (i <= a->k1)
-        x = (a->k0 > 0 ? outer_span(a, a->k0) : 0.0) + (i - a->k0) * a->w;
+        x = c0 + (i - a->k0) * a->w;
     else
-        x = (a->k0 > 0 ? outer_span(a, a->k0) : 0.0) + (a->k1 - a->k0) * a->w +
-            outer_span(a, i - a->k1);
+        x = c0 + (a->k1 - a->k0) * a->w + axis_outer_span(a, i - a->k1);
     return x / a->len;
 }
 
@@ -46,30 +44,25 @@ int map_layout_cache(map_layout *l)
 }
 
 /* Texel coordinate of fraction s along an axis: i + 0.5 at the middle of
- * texel i, linear inside each texel. */
+ * texel i, linear inside each texel (and past the ends, in the end
+ * texels' widths).  A binary search over the cached edges. */
 static double axis_coord(const map_axis *a, double s)
 {
-    double x = s * a->len;
-    double c0 = a->k0 > 0 ? outer_span(a, a->k0) : 0.0;
-    double c1 = c0 + (a->k1 - a->k0) * a->w;
-    int i;
-    if (x >= c0 && x <= c1) {
-        return a->k0 + (x - c0) / a->w;
-    } else if (x > c1) {
-        /* Invert outer_span for the (real) texel count, then interpolate
-         * linearly within the texel it falls in. */
-        double m = log1p((x - c1) * (a->r - 1.0) / (a->w * a->r)) / log(a->r);
-        i = a->k1 + (int)floor(m);
-    } else {
-        double m = log1p((c0 - x) * (a->r - 1.0) / (a->w * a->r)) / log(a->r);
-        i = a->k0 - 1 - (int)floor(m);
+    const double *e = a->edge;
+    int n = a->n;
+    if (s <= e[0])
+        return (s - e[0]) / (e[1] - e[0]);
+    if (s >= e[n])
+        return n + (s - e[n]) / (e[n] - e[n - 1]);
+    int lo = 0, hi = n; /* e[lo] <= s < e[hi] */
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (e[mid] <= s)
+            lo = mid;
+        else
+            hi = mid;
     }
-    if (i < 0) /* before the first edge */
-        return x / a->w;
-    if (i >= a->n)
-        return a->n + (x - a->len) / a->w;
-    double e0 = axis_edge(a, i), e1 = axis_edge(a, i + 1);
-    return i + (s - e0) / (e1 - e0);
+    return lo + (s - e[lo]) / (e[lo + 1] - e[lo]);
 }
 
 vec3 map_point(const map_layout *l, double s, double t)
@@ -199,13 +192,9 @@ int map_build_cover(part_map *m)
             double s = 0.5 * (s0 + s1), t = 0.5 * (t0 + t1);
             float cover = 1.0f;
             if (l->shape != SHAPE_SPHERE && l->clips > 0) {
-                vec3 q[2 * MAP_CLIPS + 8], full[4], c, cf;
+                vec3 q[2 * MAP_CLIPS + 8], c;
                 int n = map_texel_polygon(l, i, j, q, 2 * MAP_CLIPS + 8);
-                full[0] = map_point(l, s0, t0);
-                full[1] = map_point(l, s1, t0);
-                full[2] = map_point(l, s1, t1);
-                full[3] = map_point(l, s0, t1);
-                double whole = poly3_area(full, 4, &cf);
+                double whole = v3_length(v3_cross(l->du, l->dv)) * (s1 - s0) * (t1 - t0);
                 double part = n >= 3 ? poly3_area(q, n, &c) : 0.0;
                 cover = whole > 0 ? (float)fmin(1.0, part / whole) : 0.0f;
                 if (cover > 0 && cover < 1) {

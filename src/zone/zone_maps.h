@@ -76,6 +76,10 @@ static inline double axis_edge(const map_axis *a, int i) { return a->edge[i]; }
 /* Fills the edge caches of a layout's axes; 0 when out of memory. */
 int map_layout_cache(map_layout *l);
 
+/* The total width of the m texels just outside an axis' core:
+ * w r + w r^2 + ... + w r^m (0 for m = 0). */
+double axis_outer_span(const map_axis *a, int m);
+
 /* An axis with n equal texels. */
 map_axis axis_uniform(int n, double len);
 
