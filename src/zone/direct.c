@@ -142,12 +142,12 @@ static void sphere_cut(const direct_ctx *c, const light_frame *f, vec3 x, const 
                        vec3 sc, vec3 sw, double sr, poly2_set *set, poly2 *scratch)
 {
     enum { K = 24 };
-    vec3 pts[3 * K];
+    vec3 pts[POLY3_MAX + 2 * K];
     int n = 0;
     double s = f->hx > 0 ? 1.0 : -1.0, hx = fabs(f->hx);
     poly3 sil;
     disk_polygon(sc, sw, sr, K < c->sides ? c->sides : K, &sil);
-    for (int i = 0; i < sil.n && n < K; i++) {
+    for (int i = 0; i < sil.n; i++) {
         double h = s * height(f, sil.p[i]);
         if (h > 0 && h < hx)
             pts[n++] = sil.p[i];
@@ -157,7 +157,7 @@ static void sphere_cut(const direct_ctx *c, const light_frame *f, vec3 x, const 
     n += circle_points(o->p[0], o->radius, f->n, po + s * hx * (1.0 - 1e-3), K, pts + n);
     if (n < 3)
         return;
-    double xs[3 * K], ys[3 * K];
+    double xs[POLY3_MAX + 2 * K], ys[POLY3_MAX + 2 * K];
     for (int i = 0; i < n; i++) {
         double h = height(f, pts[i]);
         double t = f->hx / (f->hx - h);
@@ -430,9 +430,15 @@ static vec3 through_plane(vec3 a, vec3 b, vec3 pn, double po)
     return v3_add(a, v3_scale(d, t));
 }
 
-double direct_pixel_coverage(const direct_ctx *c, int light, vec3 eye,
+double direct_pixel_coverage(const direct_ctx *ctx, int light, vec3 eye,
                              const vec3 corner[4])
 {
+    /* Outlines of spheres as fine as polygons go: a light seen directly is
+     * the brightest thing in the image, and its edge pixels show every
+     * sliver a coarse outline gets wrong. */
+    direct_ctx fine = *ctx;
+    fine.sides = 32;
+    const direct_ctx *c = &fine;
     light_frame f;
     poly2 pieces[MAX_PIECES], scratch;
     poly2_set set = {pieces, 1, MAX_PIECES, 0};

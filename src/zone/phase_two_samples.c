@@ -4,9 +4,11 @@
  * surface: its g x g samples are shaded, each with weight 1/g^2.  Where they
  * differ, an edge crosses the pixel: a 16 x 16 grid measures the coverage of
  * each surface (group of equal signatures), and each group is shaded on the
- * samples of a sparse 4 x 4 subset that fall in it (or on its first sample
- * when it misses the subset), weighted by its coverage.  Light parts seen at
- * a corner or a sample are listed for the exact level-0 coverage. */
+ * samples of a sparse 4 x 4 subset that fall in it (or on the cell nearest
+ * its centroid when it misses the subset), weighted by its coverage.  Where
+ * a light is seen in a mirror or through glass, the grid is 64 x 64.  Light
+ * parts seen at a corner or a sample are listed for the exact level-0
+ * coverage. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,19 +19,25 @@
 
 #define EDGE_GRID 16   /* sub-pixel grid for coverage at edges */
 #define EDGE_SHADE 4   /* shaded samples per side of that grid */
+#define FINE_GRID 64   /* the grid where a light is seen by way of a mirror */
 #define SEEN_MAX 8     /* light parts listed per pixel */
 #define CURVED_GRID 2  /* sub-pixel grid of smooth pixels that see a sphere */
+/* Specular steps a signature follows.  Fixed, not the render's depth: the
+ * images of levels 0..D must use the same samples as the depth-D image,
+ * or they would not add up to it. */
+#define SIGNATURE_STEPS 16
 
 /* What a camera ray sees, as a number: the parts along its specular chain
  * (the transmitted branch through glass).  Sub-pixel samples with the same
  * signature see one smooth surface; differing ones mark an edge.  *first is
  * the ray's first hit; *curved (unless NULL) is set when the chain meets a
- * sphere. */
-static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, int steps, uint64_t *rays,
-                              hit *first, int *curved)
+ * sphere, *glint (unless NULL) when it ends on a light after a specular step. */
+static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays,
+                              hit *first, int *curved, int *glint)
 {
     uint32_t sig = 0x811c9dc5u;
-    for (int k = 0; k <= steps; k++) {
+    int inside = -1; /* the refractive object the chain is in */
+    for (int k = 0; k <= SIGNATURE_STEPS; k++) {
         hit h = accel_intersect(rs, o, d);
         (*rays)++;
         if (k == 0)
@@ -41,15 +49,26 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, int steps, uin
         const rs_object *m = &rs->objects[p->object];
         if (curved && p->shape == SHAPE_SPHERE)
             *curved = 1;
+        if (p->is_light && k > 0 && glint)
+            *glint = 1;
         if (p->is_light || m->weight[LOBE_DIFFUSE] >= 1.0f)
             break;
         vec3f x = f3_madd(o, d, h.t);
         vec3f ng = shape_normal(p, x);
         vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
-        if (m->weight[LOBE_REFRACTIVE] > 0.0f) {
-            /* Direction changes matter little for the signature: go on
-             * straight through, off the far side of the surface. */
+        float cos_o = -f3_dot(d, n);
+        /* Follow the refracted branch as it bends: a light seen through
+         * glass has its edge where the bent ray leaves it, and the coverage
+         * grid must find it there.  Entering or leaving is decided by
+         * object identity, as in the tracers, so hollow shells work. */
+        int leaving = p->object == inside;
+        float eta = leaving ? m->ior : 1.0f / m->ior;
+        float sin2_t = eta * eta * (1.0f - cos_o * cos_o);
+        if (m->weight[LOBE_REFRACTIVE] > 0.0f && sin2_t < 1.0f) {
+            float cos_t = sqrtf(1.0f - sin2_t);
+            d = f3_normalize(f3_sub(f3_scale(d, eta), f3_scale(n, cos_t - eta * cos_o)));
             o = ray_offset(x, f3_neg(n));
+            inside = leaving ? -1 : p->object;
         } else {
             d = f3_sub(d, f3_scale(n, 2.0f * f3_dot(d, n)));
             o = ray_offset(x, n);
@@ -118,7 +137,7 @@ static int grid_samples(const p2_ctx *c, int px, int py, int g, uint32_t first,
     for (int sy = 0; sy < g; sy++)
         for (int sx = 0; sx < g; sx++) {
             cam_ray(&c->c, (float)px + (sx + 0.5f) / g, (float)py + (sy + 0.5f) / g, &org, &dir);
-            if (ray_signature(rs, org, dir, c->hi, rays, &h, curved) != first)
+            if (ray_signature(rs, org, dir, rays, &h, curved, NULL) != first)
                 *edge = 1;
             note_light(rs, lights, h.part);
             if (!*edge && !push_sample(row, org, dir, h, 1.0 / (g * g)))
@@ -127,16 +146,93 @@ static int grid_samples(const p2_ctx *c, int px, int py, int g, uint32_t first,
     return 1;
 }
 
+/* Scratch for one edge pixel's coverage grid, kept with the row. */
+typedef struct edge_grid {
+    uint32_t sig[FINE_GRID * FINE_GRID], group_sig[FINE_GRID * FINE_GRID];
+    hit hits[FINE_GRID * FINE_GRID];
+    int group_of[FINE_GRID * FINE_GRID], group_count[FINE_GRID * FINE_GRID];
+    int group_shaded[FINE_GRID * FINE_GRID];
+} edge_grid;
+
+/* Samples of an edge pixel from an n x n coverage grid (n a multiple of
+ * EDGE_SHADE).  *glint is set when some sub-pixel sees a light by way of a
+ * specular surface. */
+static int edge_samples(const p2_ctx *c, int px, int py, int n, edge_grid *e,
+                        seen_lights *lights, p2_row *row, uint64_t *rays, int *glint)
+{
+    const rscene *rs = &c->r->rs;
+    const int cells = n * n, step = n / EDGE_SHADE;
+    int groups = 0;
+    vec3f org, dir;
+    for (int i = 0; i < cells; i++) {
+        int sx = i % n, sy = i / n, via = 0;
+        cam_ray(&c->c, (float)px + (sx + 0.5f) / n, (float)py + (sy + 0.5f) / n, &org, &dir);
+        e->sig[i] = ray_signature(rs, org, dir, rays, &e->hits[i], NULL, &via);
+        *glint |= via;
+        note_light(rs, lights, e->hits[i].part);
+        int k = 0;
+        while (k < groups && e->group_sig[k] != e->sig[i])
+            k++;
+        if (k == groups) {
+            e->group_sig[k] = e->sig[i];
+            e->group_count[k] = 0;
+            e->group_shaded[k] = 0;
+            groups++;
+        }
+        e->group_of[i] = k;
+        e->group_count[k]++;
+        if ((sx % step == step / 2) && (sy % step == step / 2))
+            e->group_shaded[k]++;
+    }
+    /* The subset's samples, weighted by their group's coverage. */
+    for (int i = 0; i < cells; i++) {
+        int sx = i % n, sy = i / n, k = e->group_of[i];
+        if (!((sx % step == step / 2) && (sy % step == step / 2)))
+            continue;
+        cam_ray(&c->c, (float)px + (sx + 0.5f) / n, (float)py + (sy + 0.5f) / n, &org, &dir);
+        double w = (double)e->group_count[k] / ((double)e->group_shaded[k] * cells);
+        if (!push_sample(row, org, dir, e->hits[i], w))
+            return 0;
+    }
+    /* Surfaces too small to meet the subset: the cell nearest their
+     * centroid (their first cell lies on their rim, where what they show
+     * can differ most from their mean). */
+    for (int k = 0; k < groups; k++) {
+        if (e->group_shaded[k])
+            continue;
+        double cx = 0, cy = 0;
+        for (int i = 0; i < cells; i++)
+            if (e->group_of[i] == k) {
+                cx += i % n;
+                cy += i / n;
+            }
+        cx /= e->group_count[k];
+        cy /= e->group_count[k];
+        int best = -1;
+        double best_d2 = 1e300;
+        for (int i = 0; i < cells; i++) {
+            double dx = i % n - cx, dy = i / n - cy, d2 = dx * dx + dy * dy;
+            if (e->group_of[i] == k && d2 < best_d2) {
+                best = i;
+                best_d2 = d2;
+            }
+        }
+        int sx = best % n, sy = best / n;
+        cam_ray(&c->c, (float)px + (sx + 0.5f) / n, (float)py + (sy + 0.5f) / n, &org, &dir);
+        if (!push_sample(row, org, dir, e->hits[best], (double)e->group_count[k] / cells))
+            return 0;
+    }
+    return 1;
+}
+
 /* The samples of pixel (px, py) given its corner signatures. */
 static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners[4],
                          seen_lights *lights, p2_row *row, uint64_t *rays)
 {
-    const rscene *rs = &c->r->rs;
-    int g = c->g, hi = c->hi;
+    int g = c->g;
     uint32_t first = corners[0];
     int edge = corners[1] != first || corners[2] != first || corners[3] != first;
     size_t start = row->sample_count;
-    vec3f org, dir;
     int curved = 0;
     if (!grid_samples(c, px, py, g, first, lights, row, rays, &edge, &curved))
         return 0;
@@ -152,57 +248,18 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
         return 1;
     row->sample_count = start;
 
-    enum { N = EDGE_GRID * EDGE_GRID };
-    uint32_t sigs[N], group_sig[N];
-    hit hits[N];
-    int group_of[N], group_count[N], group_shaded[N];
-    int groups = 0;
-    const int step = EDGE_GRID / EDGE_SHADE;
-    for (int i = 0; i < N; i++) {
-        int sx = i % EDGE_GRID, sy = i / EDGE_GRID;
-        cam_ray(&c->c, (float)px + (sx + 0.5f) / EDGE_GRID, (float)py + (sy + 0.5f) / EDGE_GRID,
-                &org, &dir);
-        sigs[i] = ray_signature(rs, org, dir, hi, rays, &hits[i], NULL);
-        note_light(rs, lights, hits[i].part);
-        int k = 0;
-        while (k < groups && group_sig[k] != sigs[i])
-            k++;
-        if (k == groups) {
-            group_sig[k] = sigs[i];
-            group_count[k] = 0;
-            group_shaded[k] = 0;
-            groups++;
-        }
-        group_of[i] = k;
-        group_count[k]++;
-        if ((sx % step == step / 2) && (sy % step == step / 2))
-            group_shaded[k]++;
-    }
-    /* The subset's samples, weighted by their group's coverage. */
-    for (int i = 0; i < N; i++) {
-        int sx = i % EDGE_GRID, sy = i / EDGE_GRID, k = group_of[i];
-        if (!((sx % step == step / 2) && (sy % step == step / 2)))
-            continue;
-        cam_ray(&c->c, (float)px + (sx + 0.5f) / EDGE_GRID, (float)py + (sy + 0.5f) / EDGE_GRID,
-                &org, &dir);
-        double w = (double)group_count[k] / (group_shaded[k] * EDGE_GRID * EDGE_GRID);
-        if (!push_sample(row, org, dir, hits[i], w))
+    if (!row->edge && !(row->edge = malloc(sizeof(edge_grid))))
+        return 0;
+    int glint = 0;
+    if (!edge_samples(c, px, py, EDGE_GRID, row->edge, lights, row, rays, &glint))
+        return 0;
+    if (glint) {
+        /* A light seen in a mirror or through glass: its image is the
+         * brightest thing around and often a few sub-pixels wide, so its
+         * coverage is measured on a grid 16 times as fine. */
+        row->sample_count = start;
+        if (!edge_samples(c, px, py, FINE_GRID, row->edge, lights, row, rays, &glint))
             return 0;
-    }
-    /* Surfaces too small to meet the subset: their first sample. */
-    for (int k = 0; k < groups; k++) {
-        if (group_shaded[k])
-            continue;
-        for (int i = 0; i < N; i++)
-            if (group_of[i] == k) {
-                int sx = i % EDGE_GRID, sy = i / EDGE_GRID;
-                cam_ray(&c->c, (float)px + (sx + 0.5f) / EDGE_GRID,
-                        (float)py + (sy + 0.5f) / EDGE_GRID, &org, &dir);
-                double w = (double)group_count[k] / (EDGE_GRID * EDGE_GRID);
-                if (!push_sample(row, org, dir, hits[i], w))
-                    return 0;
-                break;
-            }
     }
     return 1;
 }
@@ -227,7 +284,7 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         vec3f org, dir;
         hit h;
         cam_ray(&c->c, (float)(k % w1), (float)(y + k / w1), &org, &dir);
-        row->corner[k] = ray_signature(rs, org, dir, c->hi, rays, &h, NULL);
+        row->corner[k] = ray_signature(rs, org, dir, rays, &h, NULL, NULL);
         row->corner_part[k] = h.part;
     }
     for (int x = 0; x < w; x++) {
@@ -256,5 +313,6 @@ void p2_row_free(p2_row *row)
     free(row->light_first);
     free(row->corner);
     free(row->corner_part);
+    free(row->edge);
     memset(row, 0, sizeof *row);
 }

@@ -160,10 +160,13 @@ void poly2_hull(double *xs, double *ys, int n, poly2 *out)
         hy[k] = ys[i];
         k++;
     }
-    out->n = 0;
-    for (int i = 0; i < k - 1 && out->n < POLY2_MAX; i++) {
-        out->x[out->n] = hx[i];
-        out->y[out->n] = hy[i];
-        out->n++;
+    /* More corners than a piece holds: keep an evenly spread subset (a
+     * slightly smaller convex polygon) rather than cutting the hull off. */
+    int m = k - 1 > POLY2_MAX ? POLY2_MAX : k - 1;
+    out->n = m > 0 ? m : 0;
+    for (int i = 0; i < m; i++) {
+        int j = (int)((long)i * (k - 1) / m);
+        out->x[i] = hx[j];
+        out->y[i] = hy[j];
     }
 }
