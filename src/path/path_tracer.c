@@ -47,6 +47,7 @@ static float medium_ior(const rscene *rs, const media *m, int depth_from_top)
     return i >= 0 ? rs->objects[m->obj[i]].ior : 1.0f;
 }
 
+__attribute__((flatten))
 vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                         vec3f d, uint32_t key, uint32_t index, uint64_t *rays)
 {
