@@ -29,12 +29,13 @@ enum { BVH_STACK_SIZE = 256 };
 
 /* What the walk needs of a ray, computed once per query: the splatted
  * origin and direction, 1/d, and per axis the byte offsets into a node's
- * bounds of the corner the ray enters by and the one it leaves by. */
+ * bounds of the corner the ray enters by and the one it leaves by (a row
+ * of a constant table: copying it cost a dozen instructions a ray). */
 typedef struct bvh_ray {
     ray4 r;
     f4 ix, iy, iz;
     vec3f o, d;
-    uint32_t enter[3], leave[3];
+    const uint32_t *corner; /* enter x, y, z, then leave x, y, z */
 } bvh_ray;
 
 /* 1/d per component, in one vector division.  Finite for zero
@@ -65,9 +66,7 @@ static inline void bvh_ray_init(bvh_ray *b, const ray4 *r, vec3f o, vec3f d)
         {0, 64, 32, 48, 16, 80}, {48, 64, 32, 0, 16, 80},
         {0, 16, 80, 48, 64, 32}, {48, 16, 80, 0, 64, 32},
         {0, 64, 80, 48, 16, 32}, {48, 64, 80, 0, 16, 32}};
-    int neg = i4_bits(inv < f4_splat(0.0f)) & 7;
-    memcpy(b->enter, corners[neg], sizeof b->enter);
-    memcpy(b->leave, corners[neg] + 3, sizeof b->leave);
+    b->corner = corners[i4_bits(inv < f4_splat(0.0f)) & 7];
 }
 
 static inline f4 bvh_bound(const bvh4_node *n, uint32_t offset)
@@ -92,12 +91,12 @@ static inline float bvh_next_up(float t)
  * INFINITY. */
 static inline f4 bvh_node_entries(const bvh4_node *n, const bvh_ray *b, float tmax)
 {
-    f4 x0 = (bvh_bound(n, b->enter[0]) - b->r.ox) * b->ix;
-    f4 x1 = (bvh_bound(n, b->leave[0]) - b->r.ox) * b->ix;
-    f4 y0 = (bvh_bound(n, b->enter[1]) - b->r.oy) * b->iy;
-    f4 y1 = (bvh_bound(n, b->leave[1]) - b->r.oy) * b->iy;
-    f4 z0 = (bvh_bound(n, b->enter[2]) - b->r.oz) * b->iz;
-    f4 z1 = (bvh_bound(n, b->leave[2]) - b->r.oz) * b->iz;
+    f4 x0 = (bvh_bound(n, b->corner[0]) - b->r.ox) * b->ix;
+    f4 x1 = (bvh_bound(n, b->corner[3]) - b->r.ox) * b->ix;
+    f4 y0 = (bvh_bound(n, b->corner[1]) - b->r.oy) * b->iy;
+    f4 y1 = (bvh_bound(n, b->corner[4]) - b->r.oy) * b->iy;
+    f4 z0 = (bvh_bound(n, b->corner[2]) - b->r.oz) * b->iz;
+    f4 z1 = (bvh_bound(n, b->corner[5]) - b->r.oz) * b->iz;
     f4 t0 = f4_max(f4_max(x0, y0), f4_max(z0, f4_splat(0.0f)));
     f4 t1 = f4_min(f4_min(x1, y1), f4_min(z1, f4_splat(tmax))) * f4_splat(BVH_SLAB_ROUND_UP);
     return f4_select(t0 <= t1, t0, f4_splat(INFINITY));
