@@ -87,9 +87,10 @@ static inline float bvh_next_up(float t)
     return t;
 }
 
-/* Where the ray enters each of the node's boxes within (0, tmax), or
- * INFINITY. */
-static inline f4 bvh_node_entries(const bvh4_node *n, const bvh_ray *b, float tmax)
+/* Where the ray enters each of the node's boxes, and as bits the boxes it
+ * enters within (0, tmax) at a finite distance. */
+static inline f4 bvh_node_entries(const bvh4_node *n, const bvh_ray *b, float tmax,
+                                  int *bits)
 {
     f4 x0 = (bvh_bound(n, b->corner[0]) - b->r.ox) * b->ix;
     f4 x1 = (bvh_bound(n, b->corner[3]) - b->r.ox) * b->ix;
@@ -99,7 +100,8 @@ static inline f4 bvh_node_entries(const bvh4_node *n, const bvh_ray *b, float tm
     f4 z1 = (bvh_bound(n, b->corner[5]) - b->r.oz) * b->iz;
     f4 t0 = f4_max(f4_max(x0, y0), f4_max(z0, f4_splat(0.0f)));
     f4 t1 = f4_min(f4_min(x1, y1), f4_min(z1, f4_splat(tmax))) * f4_splat(BVH_SLAB_ROUND_UP);
-    return f4_select(t0 <= t1, t0, f4_splat(INFINITY));
+    *bits = i4_bits((t0 <= t1) & (t0 < f4_splat(INFINITY)));
+    return t0;
 }
 
 /* shape_triangle_hit on each lane, operation for operation: the lanes
@@ -172,8 +174,8 @@ static inline int bvh_traverse(const bvh_tree *tr, const bvh_ray *b, hit *h,
     for (;;) {
         if (ref >= 0) {
             const bvh4_node *n = &tr->nodes[ref];
-            f4 e = bvh_node_entries(n, b, limit);
-            int bits = i4_bits(e != f4_splat(INFINITY));
+            int bits;
+            f4 e = bvh_node_entries(n, b, limit, &bits);
             /* The boxes entered, nearest first (any order will do for
              * visibility). */
             bvh_stack_entry in[BVH_WIDTH];
