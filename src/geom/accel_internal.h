@@ -14,6 +14,9 @@ typedef struct accel {
     /* Whether the layer has any primitives (set by accel_build): most
      * scenes have only planes in one of them, and the call is skipped. */
     int has_prims[2];
+    /* The BVH backend's trees by layer, NULL for the other backends: the
+     * queries walk them inline instead of through the pointers above. */
+    const struct bvh_tree *bvh;
 } accel;
 
 zt_status accel_build_embree(rscene *rs, zt_error *err);

@@ -4,13 +4,14 @@
 #include <float.h>
 #include <string.h>
 
-#include "geom/shapes.h"
+#include "geom/bvh_traverse.h"
+#include "geom/ray4.h"
 #include "util/simd4.h"
 
 /* Planes: t = (offset - n.o) / (n.d), valid in (0, tmax) and, for culled
  * planes, only from the front.  Four planes at a time in vector lanes; a
  * failed division (n.d = 0) gives inf or nan, which compare false. */
-static inline f4 plane_block(const rs_planes *pl, int base, vec3f o, vec3f d)
+static inline f4 plane_block(const rs_planes *pl, int base, const ray4 *r)
 {
     f4 nx, ny, nz, off, cull;
     memcpy(&nx, pl->nx + base, sizeof nx);
@@ -18,8 +19,8 @@ static inline f4 plane_block(const rs_planes *pl, int base, vec3f o, vec3f d)
     memcpy(&nz, pl->nz + base, sizeof nz);
     memcpy(&off, pl->offset + base, sizeof off);
     memcpy(&cull, pl->culled + base, sizeof cull);
-    f4 dn = f4_splat(d.x) * nx + f4_splat(d.y) * ny + f4_splat(d.z) * nz;
-    f4 on = f4_splat(o.x) * nx + f4_splat(o.y) * ny + f4_splat(o.z) * nz;
+    f4 dn = r->dx * nx + r->dy * ny + r->dz * nz;
+    f4 on = r->ox * nx + r->oy * ny + r->oz * nz;
     /* Culled planes seen from behind: no hit. */
     i4 behind = (cull > f4_splat(0.0f)) & (dn >= f4_splat(0.0f));
     return f4_select(behind, f4_splat(-1.0f), (off - on) / dn);
@@ -29,12 +30,12 @@ static inline f4 plane_block(const rs_planes *pl, int base, vec3f o, vec3f d)
  * the first one on a tie, as a loop over the planes in order would pick.
  * Per block, the nearest lane is found with vector minima instead of a
  * branch per lane (whose outcome is random: it was mispredicted). */
-static inline void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d,
+static inline void planes_nearest(const rscene *rs, int layer, const ray4 *r,
                                   float *t, int *part)
 {
     const rs_planes *pl = &rs->planes[layer];
     for (int base = 0; base < pl->padded; base += PLANE_LANES) {
-        f4 tp = plane_block(pl, base, o, d);
+        f4 tp = plane_block(pl, base, r);
         i4 valid = (tp > f4_splat(0.0f)) & (tp < f4_splat(*t));
         if (!i4_bits(valid))
             continue;
@@ -45,32 +46,56 @@ static inline void planes_nearest(const rscene *rs, int layer, vec3f o, vec3f d,
     }
 }
 
-static int planes_any(const rscene *rs, int layer, vec3f o, vec3f d, float tmax)
+static inline int planes_any(const rscene *rs, int layer, const ray4 *r, float tmax)
 {
     const rs_planes *pl = &rs->planes[layer];
     for (int base = 0; base < pl->padded; base += PLANE_LANES) {
-        f4 t = plane_block(pl, base, o, d);
+        f4 t = plane_block(pl, base, r);
         if (i4_bits((t > f4_splat(0.0f)) & (t < f4_splat(tmax))))
             return 1;
     }
     return 0;
 }
 
+/* The backend's nearest hit of one layer into (*t, *part). */
+static inline void prims_nearest(const accel *a, int layer, const bvh_ray *b,
+                                 float *t, int *part)
+{
+    if (!a->has_prims[layer])
+        return;
+    hit h = {*t, *part};
+    if (a->bvh)
+        bvh_traverse(&a->bvh[layer], b, &h, 0);
+    else
+        a->nearest(a, layer, b->o, b->d, &h);
+    *t = h.t;
+    *part = h.part;
+}
+
+static inline int prims_any(const accel *a, int layer, const bvh_ray *b, float tmax)
+{
+    if (!a->has_prims[layer])
+        return 0;
+    if (a->bvh) {
+        hit h = {tmax, -1};
+        return bvh_traverse(&a->bvh[layer], b, &h, 1);
+    }
+    return a->any(a, layer, b->o, b->d, tmax);
+}
+
 hit accel_intersect(const rscene *rs, vec3f o, vec3f d)
 {
     const accel *a = rs->accel;
+    ray4 r = ray4_make(o, d);
+    bvh_ray b;
+    bvh_ray_init(&b, &r, o, d);
     for (int layer = 0; layer < 2; layer++) {
         /* The answer is built from locals, not from a struct the backend
          * wrote: that read stalled on store forwarding. */
         float t = FLT_MAX;
         int part = -1;
-        if (a->has_prims[layer]) {
-            hit h = {FLT_MAX, -1};
-            a->nearest(a, layer, o, d, &h);
-            t = h.t;
-            part = h.part;
-        }
-        planes_nearest(rs, layer, o, d, &t, &part);
+        prims_nearest(a, layer, &b, &t, &part);
+        planes_nearest(rs, layer, &r, &t, &part);
         if (part >= 0)
             return (hit){t, part};
     }
@@ -82,13 +107,14 @@ int accel_occluded(const rscene *rs, vec3f o, vec3f d, float dist,
                    int target_is_background)
 {
     const accel *a = rs->accel;
+    ray4 r = ray4_make(o, d);
+    bvh_ray b;
+    bvh_ray_init(&b, &r, o, d);
     float fg_reach = target_is_background ? FLT_MAX : dist;
-    if (planes_any(rs, 0, o, d, fg_reach) ||
-        (a->has_prims[0] && a->any(a, 0, o, d, fg_reach)))
+    if (planes_any(rs, 0, &r, fg_reach) || prims_any(a, 0, &b, fg_reach))
         return 1;
     if (target_is_background &&
-        (planes_any(rs, 1, o, d, dist) ||
-         (a->has_prims[1] && a->any(a, 1, o, d, dist))))
+        (planes_any(rs, 1, &r, dist) || prims_any(a, 1, &b, dist)))
         return 1;
     return 0;
 }

@@ -45,14 +45,15 @@ zt_status path_accumulate(zt_renderer *r, int first, int count, zt_image *sum,
         uint64_t local_rays = 0;
         for (int y = y0; y < y1; y++)
             for (int x = x0; x < x1; x++) {
-                uint32_t key = sampler_hash3((uint32_t)x, (uint32_t)y, pp.seed);
+                path_pixel pix = path_pixel_make(sampler_hash3((uint32_t)x, (uint32_t)y, pp.seed));
                 double acc[3] = {0, 0, 0};
                 for (uint32_t s = s0; s < s1; s++) {
                     float u[2];
-                    sampler_get2(key, s, 0, u);
+                    uint32_t rev_s = sampler_reverse_bits(s);
+                    sampler_get2_seeded(pix.pair_seed[0], rev_s, u);
                     vec3f org, dir;
                     cam_ray(&c, (float)x + u[0], (float)y + u[1], &org, &dir);
-                    vec3f l = path_trace_sample(rs, &pp, org, dir, key, s, &local_rays);
+                    vec3f l = path_trace_sample(rs, &pp, org, dir, &pix, s, rev_s, &local_rays);
                     acc[0] += l.x;
                     acc[1] += l.y;
                     acc[2] += l.z;

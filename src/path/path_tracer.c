@@ -21,6 +21,8 @@
 /* Vertices after the first carry less of the image and use the plain
  * stream: stratifying them measurably costs more than it gains. */
 #define STRATIFIED_VERTICES 1
+_Static_assert(1 + STRATIFIED_VERTICES * PAIRS_PER_VERTEX == PATH_SEEDED_PAIRS,
+               "the pixel holds the seed of every stratified pair");
 
 static inline float power_heuristic(float a, float b)
 {
@@ -47,8 +49,18 @@ static float medium_ior(const rscene *rs, const media *m, int depth_from_top)
     return i >= 0 ? rs->objects[m->obj[i]].ior : 1.0f;
 }
 
+path_pixel path_pixel_make(uint32_t key)
+{
+    path_pixel px = {key, {0}};
+    for (uint32_t p = 0; p < PATH_SEEDED_PAIRS; p++)
+        px.pair_seed[p] = sampler_pair_seed(key, p);
+    return px;
+}
+
+__attribute__((flatten))
 vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
-                        vec3f d, uint32_t key, uint32_t index, uint64_t *rays)
+                        vec3f d, const path_pixel *px, uint32_t index,
+                        uint32_t rev_index, uint64_t *rays)
 {
     vec3f radiance = f3_splat(0.0f), beta = f3_splat(1.0f);
     int k = 0;                /* scattering events so far */
@@ -56,7 +68,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
     float prev_pdf = 0.0f;
     vec3f prev_x = o;
     media med = {{0}, 0};
-    sampler_stream rng = sampler_stream_start(key, index);
+    sampler_stream rng = sampler_stream_start(px->key, index);
 
     for (;;) {
         hit h = accel_intersect(rs, o, d);
@@ -93,8 +105,8 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
          * them: most materials have one lobe, most scenes few lights. */
         float u_light[2] = {0.0f, 0.0f}, u_dir[2];
         if (k <= STRATIFIED_VERTICES) {
-            sampler_get2(key, index, pair, u_light);
-            sampler_get2(key, index, pair + 1, u_dir);
+            sampler_get2_seeded(px->pair_seed[pair], rev_index, u_light);
+            sampler_get2_seeded(px->pair_seed[pair + 1], rev_index, u_dir);
         } else {
             if (nee) {
                 u_light[0] = sampler_next(&rng);

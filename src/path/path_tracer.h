@@ -13,10 +13,24 @@ typedef struct path_params {
     uint32_t seed;
 } path_params;
 
-/* One radiance sample along the camera ray (o, d) for the pixel with sampler
- * key pixel_key and sample number index.  *rays counts traced rays. */
+/* The dimension pairs every sample draws from the stratified sampler: the
+ * pixel position, then the first vertex's light point and direction. */
+#define PATH_SEEDED_PAIRS 3
+
+/* A pixel's sampler key and the scramble seeds of those pairs
+ * (sampler_pair_seed), which are the same for all its samples. */
+typedef struct path_pixel {
+    uint32_t key;
+    uint32_t pair_seed[PATH_SEEDED_PAIRS];
+} path_pixel;
+
+path_pixel path_pixel_make(uint32_t key);
+
+/* One radiance sample along the camera ray (o, d) for pixel px and sample
+ * number index, whose bits reversed are rev_index.  *rays counts traced
+ * rays. */
 vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
-                        vec3f d, uint32_t pixel_key, uint32_t index,
-                        uint64_t *rays);
+                        vec3f d, const path_pixel *px, uint32_t index,
+                        uint32_t rev_index, uint64_t *rays);
 
 #endif

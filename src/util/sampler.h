@@ -72,19 +72,46 @@ static inline float sampler_to_float(uint32_t x)
     return (float)(x >> 8) * (1.0f / 16777216.0f); /* in [0, 1) */
 }
 
+/* Two reversals in one: reverse_bits of the 64-bit (hi, lo) is
+ * (reverse_bits(lo), reverse_bits(hi)), for about the work of one. */
+static inline uint64_t sampler_reverse_bits64(uint64_t x)
+{
+    x = __builtin_bswap64(x);
+    x = ((x >> 1) & 0x5555555555555555U) | ((x & 0x5555555555555555U) << 1);
+    x = ((x >> 2) & 0x3333333333333333U) | ((x & 0x3333333333333333U) << 2);
+    return ((x >> 4) & 0x0f0f0f0f0f0f0f0fU) | ((x & 0x0f0f0f0f0f0f0f0fU) << 4);
+}
+
+/* The scramble seed of (pixel key, dimension pair).  It does not depend
+ * on the sample index: callers may compute it once per pixel. */
+static inline uint32_t sampler_pair_seed(uint32_t key, uint32_t pair)
+{
+    return sampler_hash(key ^ (pair * 0x9e3779b9U + 0x51ed270bU));
+}
+
+/* The sample point of the pair with seed h (sampler_pair_seed) for the
+ * sample whose index, bit-reversed, is rev_index (shared by all pairs). */
+static inline void sampler_get2_seeded(uint32_t h, uint32_t rev_index,
+                                       float out[2])
+{
+    /* Shuffling keeps the low bits a permutation of each aligned block of
+     * indices; keeping 20 of them bounds the work below and still gives
+     * distinct points for up to 2^20 samples per pixel. */
+    uint32_t i = sampler_reverse_bits(sampler_lk_permute(rev_index, h)) & 0xfffffU;
+    /* Dimension 0 is reverse_bits(i), so its scramble needs one reversal;
+     * both outputs are reversed together. */
+    uint32_t s0 = sampler_lk_permute(i, h * 0x9e3779b9U + 1U);
+    uint32_t s1 = sampler_lk_permute(sampler_sobol1_reversed(i), h * 0x85ebca6bU + 2U);
+    uint64_t r = sampler_reverse_bits64((uint64_t)s0 << 32 | s1);
+    out[0] = sampler_to_float((uint32_t)r);
+    out[1] = sampler_to_float((uint32_t)(r >> 32));
+}
+
 /* The sample point for (pixel key, sample index, dimension pair). */
 static inline void sampler_get2(uint32_t key, uint32_t index, uint32_t pair,
                                 float out[2])
 {
-    uint32_t h = sampler_hash(key ^ (pair * 0x9e3779b9U + 0x51ed270bU));
-    /* Shuffling keeps the low bits a permutation of each aligned block of
-     * indices; keeping 20 of them bounds the work below and still gives
-     * distinct points for up to 2^20 samples per pixel. */
-    uint32_t i = sampler_owen(index, h) & 0xfffffU;
-    /* Dimension 0 is reverse_bits(i), so its scramble needs one reversal. */
-    out[0] = sampler_to_float(sampler_reverse_bits(sampler_lk_permute(i, h * 0x9e3779b9U + 1U)));
-    out[1] = sampler_to_float(sampler_reverse_bits(
-        sampler_lk_permute(sampler_sobol1_reversed(i), h * 0x85ebca6bU + 2U)));
+    sampler_get2_seeded(sampler_pair_seed(key, pair), sampler_reverse_bits(index), out);
 }
 
 /* A small per-sample random stream (PCG32's RXS-M-XS output on an LCG) for
