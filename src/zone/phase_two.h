@@ -54,6 +54,7 @@ typedef struct p2_row {
     size_t sample_count, sample_capacity;
     size_t *pixel_first;        /* width + 1 offsets into samples */
     int *lights;                /* light parts seen, per pixel */
+    double *light_cover;        /* their measured coverage, or -1: exact */
     size_t light_count, light_capacity;
     size_t *light_first;        /* width + 1 offsets into lights */
     uint32_t *corner;           /* scratch: corner signatures */
@@ -68,6 +69,7 @@ typedef struct p2_pixel {
     const p2_sample *s;
     int n;
     const int *lights;
+    const double *light_cover;  /* measured coverage of each, or -1 */
     int nlights;
 } p2_pixel;
 
@@ -117,6 +119,7 @@ static inline void p2_row_pixel(const p2_row *row, int x, int y, p2_pixel *px)
     px->s = row->samples + row->pixel_first[x];
     px->n = (int)(row->pixel_first[x + 1] - row->pixel_first[x]);
     px->lights = row->lights + row->light_first[x];
+    px->light_cover = row->light_cover + row->light_first[x];
     px->nlights = (int)(row->light_first[x + 1] - row->light_first[x]);
 }
 

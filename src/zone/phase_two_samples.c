@@ -20,6 +20,7 @@
 #define EDGE_GRID 16   /* sub-pixel grid for coverage at edges */
 #define EDGE_SHADE 4   /* shaded samples per side of that grid */
 #define FINE_GRID 64   /* the grid where a light is seen by way of a mirror */
+#define FINE_SHADE 16  /* and its shaded samples per side */
 #define SEEN_MAX 8     /* light parts listed per pixel */
 #define CURVED_GRID 2  /* sub-pixel grid of smooth pixels that see a sphere */
 /* Specular steps a signature follows.  Fixed, not the render's depth: the
@@ -79,6 +80,7 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
 
 typedef struct seen_lights {
     int part[SEEN_MAX];
+    double cover[SEEN_MAX]; /* measured coverage, or -1: computed exactly */
     int count;
 } seen_lights;
 
@@ -89,8 +91,10 @@ static void note_light(const rscene *rs, seen_lights *s, int part)
     for (int i = 0; i < s->count; i++)
         if (s->part[i] == part)
             return;
-    if (s->count < SEEN_MAX)
+    if (s->count < SEEN_MAX) {
+        s->cover[s->count] = -1.0;
         s->part[s->count++] = part;
+    }
 }
 
 static int push_sample(p2_row *row, vec3f o, vec3f d, hit h, double w)
@@ -118,10 +122,16 @@ static int push_lights(p2_row *row, const seen_lights *s)
         if (!nl)
             return 0;
         row->lights = nl;
+        double *nc = realloc(row->light_cover, cap * sizeof *nc);
+        if (!nc)
+            return 0;
+        row->light_cover = nc;
         row->light_capacity = cap;
     }
-    for (int i = 0; i < s->count; i++)
-        row->lights[row->light_count++] = s->part[i];
+    for (int i = 0; i < s->count; i++) {
+        row->lights[row->light_count] = s->part[i];
+        row->light_cover[row->light_count++] = s->cover[i];
+    }
     return 1;
 }
 
@@ -154,14 +164,17 @@ typedef struct edge_grid {
     int group_shaded[FINE_GRID * FINE_GRID];
 } edge_grid;
 
-/* Samples of an edge pixel from an n x n coverage grid (n a multiple of
- * EDGE_SHADE).  *glint is set when some sub-pixel sees a light by way of a
- * specular surface. */
-static int edge_samples(const p2_ctx *c, int px, int py, int n, edge_grid *e,
-                        seen_lights *lights, p2_row *row, uint64_t *rays, int *glint)
+/* Samples of an edge pixel from an n x n coverage grid, shaded on a
+ * shade x shade subset.  *glint is set when some sub-pixel sees a light by
+ * way of a specular surface, *rim when a light and a sphere are both seen
+ * first.  With `measure`, the lights' coverage is taken from the grid. */
+static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_grid *e,
+                        seen_lights *lights, p2_row *row, uint64_t *rays, int *glint,
+                        int *rim, int measure)
 {
+    int saw_light = 0, saw_sphere = 0;
     const rscene *rs = &c->r->rs;
-    const int cells = n * n, step = n / EDGE_SHADE;
+    const int cells = n * n, step = n / shade;
     int groups = 0;
     vec3f org, dir;
     for (int i = 0; i < cells; i++) {
@@ -170,6 +183,11 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, edge_grid *e,
         e->sig[i] = ray_signature(rs, org, dir, rays, &e->hits[i], NULL, &via);
         *glint |= via;
         note_light(rs, lights, e->hits[i].part);
+        if (e->hits[i].part >= 0) {
+            const rs_part *hp = &rs->parts[e->hits[i].part];
+            saw_light |= hp->is_light;
+            saw_sphere |= !hp->is_light && hp->shape == SHAPE_SPHERE;
+        }
         int k = 0;
         while (k < groups && e->group_sig[k] != e->sig[i])
             k++;
@@ -184,6 +202,14 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, edge_grid *e,
         if ((sx % step == step / 2) && (sy % step == step / 2))
             e->group_shaded[k]++;
     }
+    *rim = saw_light && saw_sphere;
+    if (measure)
+        for (int l = 0; l < lights->count; l++) {
+            int count = 0;
+            for (int i = 0; i < cells; i++)
+                count += e->hits[i].part == lights->part[l];
+            lights->cover[l] = (double)count / cells;
+        }
     /* The subset's samples, weighted by their group's coverage. */
     for (int i = 0; i < cells; i++) {
         int sx = i % n, sy = i / n, k = e->group_of[i];
@@ -250,15 +276,21 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
 
     if (!row->edge && !(row->edge = malloc(sizeof(edge_grid))))
         return 0;
-    int glint = 0;
-    if (!edge_samples(c, px, py, EDGE_GRID, row->edge, lights, row, rays, &glint))
+    int glint = 0, rim = 0;
+    if (!edge_samples(c, px, py, EDGE_GRID, EDGE_SHADE, row->edge, lights, row, rays, &glint,
+                      &rim, 0))
         return 0;
-    if (glint) {
+    if (glint || rim) {
         /* A light seen in a mirror or through glass: its image is the
          * brightest thing around and often a few sub-pixels wide, so its
-         * coverage is measured on a grid 16 times as fine. */
+         * coverage is measured on a grid 16 times as fine, and shaded on
+         * 16 times as many samples (near a sphere's rim what it shows
+         * swings fast).  A light beside a sphere: the exact coverage
+         * outlines the sphere by a polygon, the grid by rays; the two would
+         * leave slivers between them, so both come from the fine grid. */
         row->sample_count = start;
-        if (!edge_samples(c, px, py, FINE_GRID, row->edge, lights, row, rays, &glint))
+        if (!edge_samples(c, px, py, FINE_GRID, FINE_SHADE, row->edge, lights, row, rays,
+                          &glint, &rim, rim))
             return 0;
     }
     return 1;
@@ -290,7 +322,7 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
     for (int x = 0; x < w; x++) {
         uint32_t cs[4] = {row->corner[x], row->corner[x + 1], row->corner[w1 + x],
                           row->corner[w1 + x + 1]};
-        seen_lights lights = {{0}, 0};
+        seen_lights lights = {{0}, {0}, 0};
         note_light(rs, &lights, row->corner_part[x]);
         note_light(rs, &lights, row->corner_part[x + 1]);
         note_light(rs, &lights, row->corner_part[w1 + x]);
@@ -310,6 +342,7 @@ void p2_row_free(p2_row *row)
     free(row->samples);
     free(row->pixel_first);
     free(row->lights);
+    free(row->light_cover);
     free(row->light_first);
     free(row->corner);
     free(row->corner_part);

@@ -244,9 +244,13 @@ static vec3 specular_value(zone_trace *t, const p2_term *term, const p2_sample *
 }
 
 /* Level 0 of a light part in a pixel: its exact coverage x emission. */
-static vec3 root_value(const p2_ctx *c, zone_trace *t, int light, const p2_pixel *px)
+static vec3 root_value(const p2_ctx *c, zone_trace *t, int i, const p2_pixel *px)
 {
     const rscene *rs = &t->r->rs;
+    int light = px->lights[i];
+    vec3f e = rs->objects[rs->parts[light].object].emission;
+    if (px->light_cover[i] >= 0)
+        return v3_scale(to_d(e), px->light_cover[i]);
     vec3 corner[4];
     const float cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
     for (int i = 0; i < 4; i++) {
@@ -256,7 +260,6 @@ static vec3 root_value(const p2_ctx *c, zone_trace *t, int light, const p2_pixel
     }
     vec3 eye = to_d(c->c.viewpoint);
     double cov = direct_pixel_coverage(&t->f->direct, light, eye, corner);
-    vec3f e = rs->objects[rs->parts[light].object].emission;
     return v3_scale(to_d(e), cov);
 }
 
@@ -274,7 +277,7 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
     case P2_ROOT:
         for (int i = 0; i < px->nlights; i++)
             if (px->lights[i] == term->part) {
-                add(acc, 1.0, root_value(c, t, term->part, px));
+                add(acc, 1.0, root_value(c, t, i, px));
                 break;
             }
         return;
@@ -305,7 +308,7 @@ void p2_reference(const p2_ctx *c, zone_trace *t, const p2_pixel *px, double acc
     if (c->lo == 0)
         for (int i = 0; i < px->nlights; i++)
             if (!f3_is_black(rs->objects[rs->parts[px->lights[i]].object].emission))
-                add(acc, 1.0, root_value(c, t, px->lights[i], px));
+                add(acc, 1.0, root_value(c, t, i, px));
     for (int i = 0; i < px->n; i++)
         add(acc, px->s[i].w,
             zone_radiance(t, px->s[i].o, px->s[i].d, c->lo, c->hi, SHADE_FLAGS, NULL, 0));
