@@ -11,6 +11,7 @@
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
 #include "util/error.h"
+#include "zone/glint.h"
 #include "zone/map_layout.h"
 #include "zone/transfer.h"
 #include "zone/zone_internal.h"
@@ -131,8 +132,11 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
         if (f3_is_black(rs->sky))
             return e;
     } else {
-        /* Flat diffuse surfaces by exact transfer over their maps. */
+        /* Flat diffuse surfaces by exact transfer over their maps; lights
+         * in mirror spheres by their images. */
         e = transfer_irradiance(t, part_index, x, n, level, theta);
+        if (level == 1 && f->glints)
+            e = v3_add(e, glint_irradiance(t, x, n, f->q.glint_cuts));
         if (!f->need_gather)
             return e;
     }
@@ -154,8 +158,8 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
             t->rays++;
             l = h.part < 0 ? v3(rs->sky.x, rs->sky.y, rs->sky.z) : v3(0, 0, 0);
         } else {
-            l = zone_radiance(t, o, to_f(v3_normalize(d)), level, level, ZR_SKIP_FLAT_DIFFUSE,
-                              NULL, 0);
+            l = zone_radiance(t, o, to_f(v3_normalize(d)), level, level,
+                              ZR_SKIP_FLAT_DIFFUSE | ZR_NO_GLINT, NULL, 0);
         }
         sum = v3_add(sum, l);
     }
@@ -337,6 +341,9 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
     /* Gathers are needed for what transfer does not cover: light arriving
      * from specular surfaces or diffuse spheres. */
     f->need_gather = 0;
+    f->glints = 0;
+    for (int i = 0; i < r->rs.part_count; i++)
+        f->glints |= glint_sphere(&r->rs, i);
     for (int i = 0; i < sc->part_count; i++) {
         const object *o = &sc->objects[sc->parts[i].object];
         if (o->is_light)

@@ -42,6 +42,7 @@ typedef struct zone_quality {
     double texel_divisor; /* texel = scene extent / texel_divisor */
     double theta;       /* transfer: pieces are split above this size/distance */
     int max_texels;     /* at most this many texels along a map's side */
+    int glint_cuts;     /* a light triangle is cut n x n for its images */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;
@@ -60,6 +61,7 @@ typedef struct zone_forest {
     direct_ctx direct;
     zone_quality q;
     int need_gather;    /* some light arrives by specular surfaces or spheres */
+    int glints;         /* some sphere reflects lights as images (glint.h) */
     vec3 *dirs;         /* the gather directions (q.gather of them) */
     transfer_blockers *blockers; /* Phase One: what may hide a piece */
     double phase_one_seconds;
@@ -93,8 +95,10 @@ enum {
     ZR_EXACT_DIRECT = 1, /* level 1 from the analytic direct term, not maps */
     ZR_NO_EMISSION = 2,  /* lights hit by this very ray count nothing (the
                             camera's level 0 is measured analytically) */
-    ZR_SKIP_FLAT_DIFFUSE = 4 /* the diffuse lobe of a flat part hit by this
+    ZR_SKIP_FLAT_DIFFUSE = 4, /* the diffuse lobe of a flat part hit by this
                             very ray counts nothing (transfer covers it) */
+    ZR_NO_GLINT = 8      /* a light seen in a glint sphere (glint.h) by this
+                            very ray counts nothing (its image covers it) */
 };
 vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count);

@@ -13,6 +13,7 @@
 #include "geom/shapes.h"
 #include "light/light_sample.h"
 #include "material/bsdf.h"
+#include "zone/glint.h"
 
 #define MEDIA_MAX 8
 
@@ -106,7 +107,10 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
             k_tran = wt * (1.0 - fr);
         }
         if (k_refl > 0) {
-            vec3 l = zone_radiance(t, out_o, refl, lo - 1, hi - 1, exact_direct, media, media_count);
+            int rflags = exact_direct;
+            if ((flags & ZR_NO_GLINT) && glint_sphere(rs, h.part))
+                rflags |= ZR_NO_EMISSION;
+            vec3 l = zone_radiance(t, out_o, refl, lo - 1, hi - 1, rflags, media, media_count);
             out = v3_add(out, v3_scale(v3_mul(color, l), k_refl));
         }
         if (k_tran > 0) {

@@ -1,0 +1,235 @@
+#include "zone/glint.h"
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "light/light_sample.h"
+#include "material/bsdf.h"
+#include "zone/lambert.h"
+
+#define DISK_SIDES_MAX 32  /* a sphere light's outline, as seen from its image */
+#define BISECT_STEPS 32    /* the specular point to about 1e-10 of the arc */
+
+static vec3f to_f(vec3 v) { return f3((float)v.x, (float)v.y, (float)v.z); }
+
+int glint_sphere(const rscene *rs, int i)
+{
+    const rs_part *p = &rs->parts[i];
+    if (p->is_light || p->shape != SHAPE_SPHERE)
+        return 0;
+    const rs_object *m = &rs->objects[p->object];
+    return m->weight[LOBE_REFRACTIVE] == 0.0f &&
+           (m->weight[LOBE_REFLECTING] > 0.0f || m->weight[LOBE_METALLIC] > 0.0f);
+}
+
+/* The point s on sphere (c, r) where light from y reflects towards x (both
+ * outside): in the plane of c, x and y, the angle phi of s runs from x's
+ * direction to y's, and at s the unit vectors to x and y have no component
+ * along the tangent.  Returns 0 when the reflection would be at or past
+ * grazing for either point. */
+static int specular_point(vec3 c, double r, vec3 x, vec3 y, vec3 *s)
+{
+    vec3 px = v3_sub(x, c), py = v3_sub(y, c);
+    double lx = v3_length(px);
+    vec3 e1 = v3_scale(px, 1.0 / lx);
+    vec3 t = v3_sub(py, v3_scale(e1, v3_dot(py, e1)));
+    double tl = v3_length(t);
+    if (tl < 1e-12 * v3_length(py)) {
+        /* y on x's line through the centre: the reflection is back along it. */
+        if (v3_dot(py, e1) <= 0)
+            return 0;
+        *s = v3_add(c, v3_scale(e1, r));
+        return 1;
+    }
+    vec3 e2 = v3_scale(t, 1.0 / tl);
+    double yx = v3_dot(py, e1), yy = tl;
+    double lo = 0.0, hi = atan2(yy, yx);
+    for (int k = 0; k < BISECT_STEPS; k++) {
+        double phi = 0.5 * (lo + hi), cs = cos(phi), sn = sin(phi);
+        double sx = r * cs, sy = r * sn;
+        double ax = lx - sx, ay = -sy, bx = yx - sx, by = yy - sy;
+        double la = sqrt(ax * ax + ay * ay), lb = sqrt(bx * bx + by * by);
+        /* Tangential component (-sin, cos) of the sum of unit vectors. */
+        double g = (-sn * ax + cs * ay) / la + (-sn * bx + cs * by) / lb;
+        if (g > 0)
+            lo = phi;
+        else
+            hi = phi;
+    }
+    double phi = 0.5 * (lo + hi);
+    vec3 n = v3_add(v3_scale(e1, cos(phi)), v3_scale(e2, sin(phi)));
+    *s = v3_add(c, v3_scale(n, r));
+    return v3_dot(n, v3_sub(x, *s)) > 0 && v3_dot(n, v3_sub(y, *s)) > 0;
+}
+
+/* Irradiance at x (normal n) of unit radiance arriving from the directions
+ * of the points q[0..2]: the triangle of directions, clipped to x's
+ * horizon. */
+static double image_irradiance(vec3 x, vec3 n, const vec3 q[3])
+{
+    vec3 a[3], out[4];
+    double h[3];
+    for (int i = 0; i < 3; i++) {
+        a[i] = v3_add(x, v3_normalize(v3_sub(q[i], x)));
+        h[i] = v3_dot(n, v3_sub(a[i], x));
+    }
+    int m = 0;
+    for (int i = 0, j = 2; i < 3; j = i++) {
+        if ((h[j] > 0) != (h[i] > 0)) {
+            double u = h[j] / (h[j] - h[i]);
+            out[m++] = v3_add(a[j], v3_scale(v3_sub(a[i], a[j]), u));
+        }
+        if (h[i] > 0)
+            out[m++] = a[i];
+    }
+    return m >= 3 ? lambert_polygon(x, n, out, m) : 0.0;
+}
+
+/* Whether the path x -> s -> y is open: x on a receiver with normal n, s
+ * on sphere part `mirror`, y on light part `light`. */
+static int path_open(const rscene *rs, vec3 x, vec3 n, vec3 s, vec3 c, int mirror, vec3 y,
+                     int light, uint64_t *rays)
+{
+    *rays += 2;
+    vec3f xo = ray_offset(to_f(x), to_f(n));
+    vec3 d1 = v3_sub(s, v3(xo.x, xo.y, xo.z));
+    double l1 = v3_length(d1);
+    if (accel_occluded(rs, xo, to_f(v3_scale(d1, 1.0 / l1)), (float)(l1 * 0.9999),
+                       rs->parts[mirror].background))
+        return 0;
+    vec3f so = ray_offset(to_f(s), to_f(v3_normalize(v3_sub(s, c))));
+    vec3 d2 = v3_sub(y, v3(so.x, so.y, so.z));
+    double l2 = v3_length(d2);
+    return !accel_occluded(rs, so, to_f(v3_scale(d2, 1.0 / l2)), (float)(l2 * 0.9999),
+                           rs->parts[light].background);
+}
+
+/* Radiance reflected towards x by the sphere part `mirror` from light part
+ * `light` at point y: emission, tint and reflectance at y's specular
+ * point, or zero when x -> s -> y is blocked. */
+static vec3 reflected(const rscene *rs, vec3 x, vec3 n, int mirror, int light, vec3 y,
+                      uint64_t *rays)
+{
+    const rs_part *sp = &rs->parts[mirror];
+    const rs_object *m = &rs->objects[sp->object];
+    vec3 c = v3(sp->p0.x, sp->p0.y, sp->p0.z), s;
+    if (!specular_point(c, sp->radius, x, y, &s) || !path_open(rs, x, n, s, c, mirror, y, light, rays))
+        return v3(0, 0, 0);
+    vec3 ns = v3_normalize(v3_sub(s, c));
+    float cos_i = (float)v3_dot(ns, v3_normalize(v3_sub(x, s)));
+    double k = m->weight[LOBE_REFLECTING];
+    if (m->weight[LOBE_METALLIC] > 0.0f)
+        k += m->weight[LOBE_METALLIC] * bsdf_schlick(cos_i, m->ior);
+    vec3f le = light_emitted(rs, &rs->parts[light], to_f(y), to_f(v3_normalize(v3_sub(y, s))));
+    return v3_scale(v3(le.x * m->color.x, le.y * m->color.y, le.z * m->color.z), k);
+}
+
+#define CUTS_MAX 8
+
+/* The image of light triangle v[0..2] cut into n x n small triangles (its
+ * outline follows the sphere's curvature better), with visibility,
+ * emission and reflectance taken at the triangle's centre; the grid's
+ * corners are carried to the sphere once each. */
+static vec3 light_triangle(const rscene *rs, vec3 x, vec3 nx, int mirror, int light,
+                           const vec3 v[3], int n, uint64_t *rays)
+{
+    const rs_part *sp = &rs->parts[mirror];
+    vec3 c = v3(sp->p0.x, sp->p0.y, sp->p0.z);
+    if (n > CUTS_MAX)
+        n = CUTS_MAX;
+    vec3 s[CUTS_MAX + 1][CUTS_MAX + 1];
+    unsigned char ok[CUTS_MAX + 1][CUTS_MAX + 1];
+    vec3 e1 = v3_scale(v3_sub(v[1], v[0]), 1.0 / n), e2 = v3_scale(v3_sub(v[2], v[0]), 1.0 / n);
+    for (int i = 0; i <= n; i++)
+        for (int j = 0; i + j <= n; j++) {
+            vec3 y = v3_add(v[0], v3_add(v3_scale(e1, i), v3_scale(e2, j)));
+            ok[i][j] = (unsigned char)specular_point(c, sp->radius, x, y, &s[i][j]);
+        }
+    double g = 0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; i + j < n; j++) {
+            if (ok[i][j] && ok[i + 1][j] && ok[i][j + 1]) {
+                vec3 ss[3] = {s[i][j], s[i + 1][j], s[i][j + 1]};
+                g += image_irradiance(x, nx, ss);
+            }
+            if (i + j + 1 < n && ok[i + 1][j] && ok[i + 1][j + 1] && ok[i][j + 1]) {
+                vec3 ss[3] = {s[i + 1][j], s[i + 1][j + 1], s[i][j + 1]};
+                g += image_irradiance(x, nx, ss);
+            }
+        }
+    if (g <= 0)
+        return v3(0, 0, 0);
+    vec3 yc = v3_scale(v3_add(v3_add(v[0], v[1]), v[2]), 1.0 / 3.0);
+    return v3_scale(reflected(rs, x, nx, mirror, light, yc, rays), g);
+}
+
+/* A sphere light's image: its outline as seen from the specular point of
+ * its centre, a fan of triangles around that centre. */
+static vec3 light_sphere(const rscene *rs, vec3 x, vec3 nx, int mirror, int light, int n,
+                         uint64_t *rays)
+{
+
+    const rs_part *lp = &rs->parts[light], *sp = &rs->parts[mirror];
+    vec3 cl = v3(lp->p0.x, lp->p0.y, lp->p0.z), c = v3(sp->p0.x, sp->p0.y, sp->p0.z), s0;
+    double rl = lp->radius;
+    if (!specular_point(c, sp->radius, x, cl, &s0))
+        return v3(0, 0, 0);
+    vec3 d = v3_sub(cl, s0);
+    double dist = v3_length(d);
+    if (dist <= rl)
+        return v3(0, 0, 0);
+    vec3 w = v3_scale(d, 1.0 / dist);
+    vec3 oc = v3_sub(cl, v3_scale(w, rl * rl / dist)); /* outline's centre and radius */
+    double orad = rl * sqrt(1.0 - rl * rl / (dist * dist));
+    vec3 u = v3_normalize(v3_cross(fabs(w.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0), w));
+    vec3 v = v3_cross(w, u);
+    int sides = 4 * n < DISK_SIDES_MAX ? 4 * n : DISK_SIDES_MAX;
+    double step = 2.0 * 3.14159265358979323846 / sides;
+    double re = orad * sqrt(step / sin(step)); /* a polygon of the disk's area */
+    vec3 ring[DISK_SIDES_MAX], sc;
+    if (!specular_point(c, sp->radius, x, oc, &sc))
+        return v3(0, 0, 0);
+    for (int i = 0; i < sides; i++) {
+        vec3 y = v3_add(oc, v3_add(v3_scale(u, re * cos(i * step)), v3_scale(v, re * sin(i * step))));
+        if (!specular_point(c, sp->radius, x, y, &ring[i]))
+            return v3(0, 0, 0);
+    }
+    double g = 0;
+    for (int i = 0; i < sides; i++) {
+        vec3 ss[3] = {sc, ring[i], ring[(i + 1) % sides]};
+        g += image_irradiance(x, nx, ss);
+    }
+    if (g <= 0)
+        return v3(0, 0, 0);
+    /* Visibility and emission at the light's surface point facing the
+     * image (the outline's centre lies inside the light). */
+    return v3_scale(reflected(rs, x, nx, mirror, light, v3_sub(cl, v3_scale(w, rl)), rays), g);
+}
+
+vec3 glint_irradiance(zone_trace *t, vec3 x, vec3 n, int subdivisions)
+{
+    const rscene *rs = &t->r->rs;
+    vec3 e = v3(0, 0, 0);
+    for (int mi = 0; mi < rs->part_count; mi++) {
+        if (!glint_sphere(rs, mi))
+            continue;
+        const rs_part *sp = &rs->parts[mi];
+        vec3 c = v3(sp->p0.x, sp->p0.y, sp->p0.z);
+        /* Nothing of the sphere above x's horizon, or x inside it. */
+        if (v3_dot(n, v3_sub(c, x)) <= -sp->radius || v3_length(v3_sub(c, x)) <= sp->radius)
+            continue;
+        for (int li = 0; li < rs->part_count; li++) {
+            const rs_part *lp = &rs->parts[li];
+            if (!lp->is_light || f3_is_black(rs->objects[lp->object].emission))
+                continue;
+            if (lp->shape == SHAPE_TRIANGLE) {
+                vec3 p0 = v3(lp->p0.x, lp->p0.y, lp->p0.z);
+                vec3 v[3] = {p0, v3_add(p0, v3(lp->e1.x, lp->e1.y, lp->e1.z)),
+                             v3_add(p0, v3(lp->e2.x, lp->e2.y, lp->e2.z))};
+                e = v3_add(e, light_triangle(rs, x, n, mi, li, v, subdivisions, &t->rays));
+            } else if (lp->shape == SHAPE_SPHERE) {
+                e = v3_add(e, light_sphere(rs, x, n, mi, li, subdivisions, &t->rays));
+            }
+        }
+    }
+    return e;
+}
