@@ -142,34 +142,45 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             }
         }
 
-        /* Continue along a sampled direction. */
-        int entering = med.n == 0 || med.obj[med.n - 1] != p->object;
-        float eta_i = medium_ior(rs, &med, 0);
-        float eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
-        float u_lobe = m->lobe_choice ? sampler_next(&rng) : 0.0f;
-        float u_split = m->weight[LOBE_REFRACTIVE] > 0.0f ? sampler_next(&rng) : 0.0f;
-        /* Flat parts carry their frame; with n flipped, (t, b, n) is still
-         * orthonormal (left-handed), which the cosine lobe does not mind. */
+        /* Continue along a sampled direction.  Flat parts carry their
+         * frame; with n flipped, (t, b, n) is still orthonormal
+         * (left-handed), which the cosine lobe does not mind. */
         shading_frame frame = {p->tangent, p->bitangent, n};
         if (p->shape == SHAPE_SPHERE)
             f3_basis(n, &frame.t, &frame.b);
         bsdf_sample bs;
-        if (!bsdf_sample_material(m, &frame, wo, u_lobe, u_split, u_dir,
-                                  eta_i, eta_t, &bs))
-            break;
-        beta = f3_mul(beta, bs.weight);
-        if (f3_is_black(beta))
-            break;
-        if (bs.transmit) {
-            if (entering) {
-                if (med.n < MEDIUM_STACK)
-                    med.obj[med.n++] = p->object;
-            } else {
-                med.n--;
-            }
-            o = ray_offset(x, f3_neg(n));
-        } else {
+        if (!m->lobe_choice && m->weight[LOBE_DIFFUSE] > 0.0f) {
+            /* Diffuse only, the common case: no lobe or split to draw, no
+             * medium to track, and the same sample as the general call. */
+            if (!bsdf_sample_diffuse(m, &frame, u_dir, &bs))
+                break;
+            beta = f3_mul(beta, bs.weight);
+            if (f3_is_black(beta))
+                break;
             o = x_out;
+        } else {
+            int entering = med.n == 0 || med.obj[med.n - 1] != p->object;
+            float eta_i = medium_ior(rs, &med, 0);
+            float eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
+            float u_lobe = m->lobe_choice ? sampler_next(&rng) : 0.0f;
+            float u_split = m->weight[LOBE_REFRACTIVE] > 0.0f ? sampler_next(&rng) : 0.0f;
+            if (!bsdf_sample_material(m, &frame, wo, u_lobe, u_split, u_dir,
+                                      eta_i, eta_t, &bs))
+                break;
+            beta = f3_mul(beta, bs.weight);
+            if (f3_is_black(beta))
+                break;
+            if (bs.transmit) {
+                if (entering) {
+                    if (med.n < MEDIUM_STACK)
+                        med.obj[med.n++] = p->object;
+                } else {
+                    med.n--;
+                }
+                o = ray_offset(x, f3_neg(n));
+            } else {
+                o = x_out;
+            }
         }
         prev_delta = bs.delta;
         prev_pdf = bs.pdf;
