@@ -67,12 +67,15 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
     int prev_delta = 1;       /* the camera counts as a delta vertex */
     float prev_pdf = 0.0f;
     vec3f prev_x = o;
-    media med = {{0}, 0};
+    media med;
+    med.n = 0; /* obj[] is read only below n */
     sampler_stream rng = sampler_stream_start(px->key, index);
+    /* Counted in a register, not through the pointer at every ray. */
+    uint64_t n_rays = 0;
 
     for (;;) {
         hit h = accel_intersect(rs, o, d);
-        (*rays)++;
+        n_rays++;
         int counted = k >= pp->min_level;
         if (h.part < 0) {
             if (counted)
@@ -124,7 +127,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             float bsdf_pdf;
             vec3f fcos = bsdf_eval_diffuse(m, n, ls.wi, &bsdf_pdf);
             if (bsdf_pdf > 0.0f && !f3_is_black(ls.li)) {
-                (*rays)++;
+                n_rays++;
                 const rs_part *lp = &rs->parts[ls.part];
                 /* Aim the shadow ray from the offset origin at the sampled
                  * point itself: near a sphere's rim, keeping the direction
@@ -197,6 +200,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             beta = f3_scale(beta, 1.0f / q);
         }
     }
+    *rays += n_rays;
     if (!isfinite(radiance.x) || !isfinite(radiance.y) || !isfinite(radiance.z))
         return f3_splat(0.0f);
     return radiance;
