@@ -250,6 +250,24 @@ static void test_plane(void **state)
     }
 }
 
+/* The vector ray_offset gives the scalar reference's bits, either side of
+ * the 1/32 switch, at both signs and zero. */
+static void test_ray_offset_matches_scalar(void **state)
+{
+    (void)state;
+    uint32_t seed = 777;
+    const float mags[] = {0, 1e-8f, 0.03124f, 0.03125f, 0.0313f, 1, 556, 1e6f};
+    for (size_t m = 0; m < sizeof mags / sizeof mags[0]; m++)
+        for (int i = 0; i < 500; i++) {
+            vec3f p = f3_scale(rnd_dir(&seed), mags[m]);
+            if (i % 7 == 0)
+                p = f3(mags[m], -mags[m], i % 2 ? -0.0f : 0.0f);
+            vec3f n = f3_scale(rnd_dir(&seed), i % 3 ? 1.0f : -1.0f);
+            vec3f a = ray_offset(p, n), b = ray_offset_scalar(p, n);
+            assert_memory_equal(&a, &b, sizeof a);
+        }
+}
+
 /* Points moved off along n (and against it) end up on that side, not far. */
 static void test_ray_offset_sides(void **state)
 {
@@ -388,6 +406,7 @@ int main(void)
         cmocka_unit_test(test_large_and_tiny_coordinates),
         cmocka_unit_test(test_plane),
         cmocka_unit_test(test_ray_offset_sides),
+        cmocka_unit_test(test_ray_offset_matches_scalar),
         cmocka_unit_test(test_sphere_restart_after_offset),
         cmocka_unit_test(test_triangle_restart_after_offset),
     };

@@ -8,6 +8,7 @@
 
 #include <stdint.h>
 #include <string.h>
+#include "util/simd4.h"
 #include "util/vec3f.h"
 
 static inline float offset_component(float p, float n)
@@ -26,11 +27,29 @@ static inline float offset_component(float p, float n)
 }
 
 /* p moved off the surface to the side that n (geometric normal, any
- * length) points to. */
-static inline vec3f ray_offset(vec3f p, vec3f n)
+ * length) points to, one component at a time (the reference). */
+static inline vec3f ray_offset_scalar(vec3f p, vec3f n)
 {
     return f3(offset_component(p.x, n.x), offset_component(p.y, n.y),
               offset_component(p.z, n.z));
+}
+
+/* The same bits as ray_offset_scalar, the three components in vector lanes:
+ * the scalar form cost two branches and about 45 instructions per vertex. */
+typedef uint32_t u4 __attribute__((vector_size(16)));
+
+static inline vec3f ray_offset(vec3f p, vec3f n)
+{
+    f4 pv = {p.x, p.y, p.z, 0.0f}, nv = {n.x, n.y, n.z, 0.0f};
+    f4 near = pv + f4_splat(1.0f / 65536.0f) * nv;
+    i4 of = __builtin_convertvector(f4_splat(256.0f) * nv, i4);
+    u4 neg = (u4)(pv < f4_splat(0.0f));
+    /* Both forms are computed: unsigned lanes, since the unused one may
+     * wrap (-0.0 is INT_MIN as bits).  (of ^ ~0) + 1 is -of. */
+    u4 far = (u4)pv + (((u4)of ^ neg) - neg);
+    i4 small = ((i4)pv & i4_splat(0x7fffffff)) < i4_splat(0x3d000000); /* |p| < 1/32 */
+    f4 r = f4_select(small, near, (f4)far);
+    return f3(r[0], r[1], r[2]);
 }
 
 #endif

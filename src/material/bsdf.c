@@ -1,6 +1,5 @@
 #include "material/bsdf.h"
 
-#include "util/sincos_turn.h"
 
 static vec3f reflect(vec3f wo, vec3f n)
 {
@@ -29,15 +28,6 @@ float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t)
     return 0.5f * (rs * rs + rp * rp);
 }
 
-static vec3f cosine_hemisphere(const shading_frame *f, const float u[2])
-{
-    float r = sqrtf(u[0]), sin_phi, cos_phi;
-    sincos_turn(u[1], &sin_phi, &cos_phi);
-    float z = sqrtf(f_max0(1.0f - u[0]));
-    return f3_add(f3_add(f3_scale(f->t, r * cos_phi), f3_scale(f->b, r * sin_phi)),
-                  f3_scale(f->n, z));
-}
-
 int bsdf_sample_material(const rs_object *m, const shading_frame *f, vec3f wo, float u_lobe,
                          float u_split, const float u2[2], float eta_i,
                          float eta_t, bsdf_sample *out)
@@ -62,10 +52,7 @@ int bsdf_sample_material(const rs_object *m, const shading_frame *f, vec3f wo, f
     out->pdf = 0.0f;
     switch (lobe) {
     case LOBE_DIFFUSE:
-        out->wi = cosine_hemisphere(f, u2);
-        out->pdf = m->weight[LOBE_DIFFUSE] * f3_dot(n, out->wi) * ZT_INV_PI;
-        out->weight = m->color;
-        return out->pdf > 0.0f;
+        return bsdf_sample_diffuse(m, f, u2, out);
     case LOBE_METALLIC:
         out->wi = reflect(wo, n);
         out->weight = f3_scale(m->color, bsdf_schlick(cos_o, m->ior));

@@ -6,6 +6,7 @@
 #define ZT_MATERIAL_BSDF_H
 
 #include "render/render_scene.h"
+#include "util/sincos_turn.h"
 
 #define ZT_PI 3.14159265358979f
 /* Multiplying by it instead of dividing by ZT_PI saves a division's
@@ -39,6 +40,28 @@ static inline vec3f bsdf_eval_diffuse(const rs_object *m, vec3f n, vec3f wi,
     float w = m->weight[LOBE_DIFFUSE];
     *pdf = w * c * ZT_INV_PI;
     return f3_scale(m->color, *pdf);
+}
+
+static inline vec3f bsdf_cosine_hemisphere(const shading_frame *f, const float u[2])
+{
+    float r = sqrtf(u[0]), sin_phi, cos_phi;
+    sincos_turn(u[1], &sin_phi, &cos_phi);
+    float z = sqrtf(f_max0(1.0f - u[0]));
+    return f3_add(f3_add(f3_scale(f->t, r * cos_phi), f3_scale(f->b, r * sin_phi)),
+                  f3_scale(f->n, z));
+}
+
+/* The diffuse lobe's part of bsdf_sample_material, once it is chosen; the
+ * path tracer calls it directly for materials with no other lobe. */
+static inline int bsdf_sample_diffuse(const rs_object *m, const shading_frame *f,
+                                      const float u2[2], bsdf_sample *out)
+{
+    out->wi = bsdf_cosine_hemisphere(f, u2);
+    out->pdf = m->weight[LOBE_DIFFUSE] * f3_dot(f->n, out->wi) * ZT_INV_PI;
+    out->weight = m->color;
+    out->delta = 0;
+    out->transmit = 0;
+    return out->pdf > 0.0f;
 }
 
 /* Schlick's Fresnel with R0 from the index, as the original programs

@@ -67,12 +67,15 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
     int prev_delta = 1;       /* the camera counts as a delta vertex */
     float prev_pdf = 0.0f;
     vec3f prev_x = o;
-    media med = {{0}, 0};
+    media med;
+    med.n = 0; /* obj[] is read only below n */
     sampler_stream rng = sampler_stream_start(px->key, index);
+    /* Counted in a register, not through the pointer at every ray. */
+    uint64_t n_rays = 0;
 
     for (;;) {
         hit h = accel_intersect(rs, o, d);
-        (*rays)++;
+        n_rays++;
         int counted = k >= pp->min_level;
         if (h.part < 0) {
             if (counted)
@@ -124,7 +127,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             float bsdf_pdf;
             vec3f fcos = bsdf_eval_diffuse(m, n, ls.wi, &bsdf_pdf);
             if (bsdf_pdf > 0.0f && !f3_is_black(ls.li)) {
-                (*rays)++;
+                n_rays++;
                 const rs_part *lp = &rs->parts[ls.part];
                 /* Aim the shadow ray from the offset origin at the sampled
                  * point itself: near a sphere's rim, keeping the direction
@@ -142,34 +145,45 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             }
         }
 
-        /* Continue along a sampled direction. */
-        int entering = med.n == 0 || med.obj[med.n - 1] != p->object;
-        float eta_i = medium_ior(rs, &med, 0);
-        float eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
-        float u_lobe = m->lobe_choice ? sampler_next(&rng) : 0.0f;
-        float u_split = m->weight[LOBE_REFRACTIVE] > 0.0f ? sampler_next(&rng) : 0.0f;
-        /* Flat parts carry their frame; with n flipped, (t, b, n) is still
-         * orthonormal (left-handed), which the cosine lobe does not mind. */
+        /* Continue along a sampled direction.  Flat parts carry their
+         * frame; with n flipped, (t, b, n) is still orthonormal
+         * (left-handed), which the cosine lobe does not mind. */
         shading_frame frame = {p->tangent, p->bitangent, n};
         if (p->shape == SHAPE_SPHERE)
             f3_basis(n, &frame.t, &frame.b);
         bsdf_sample bs;
-        if (!bsdf_sample_material(m, &frame, wo, u_lobe, u_split, u_dir,
-                                  eta_i, eta_t, &bs))
-            break;
-        beta = f3_mul(beta, bs.weight);
-        if (f3_is_black(beta))
-            break;
-        if (bs.transmit) {
-            if (entering) {
-                if (med.n < MEDIUM_STACK)
-                    med.obj[med.n++] = p->object;
-            } else {
-                med.n--;
-            }
-            o = ray_offset(x, f3_neg(n));
-        } else {
+        if (!m->lobe_choice && m->weight[LOBE_DIFFUSE] > 0.0f) {
+            /* Diffuse only, the common case: no lobe or split to draw, no
+             * medium to track, and the same sample as the general call. */
+            if (!bsdf_sample_diffuse(m, &frame, u_dir, &bs))
+                break;
+            beta = f3_mul(beta, bs.weight);
+            if (f3_is_black(beta))
+                break;
             o = x_out;
+        } else {
+            int entering = med.n == 0 || med.obj[med.n - 1] != p->object;
+            float eta_i = medium_ior(rs, &med, 0);
+            float eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
+            float u_lobe = m->lobe_choice ? sampler_next(&rng) : 0.0f;
+            float u_split = m->weight[LOBE_REFRACTIVE] > 0.0f ? sampler_next(&rng) : 0.0f;
+            if (!bsdf_sample_material(m, &frame, wo, u_lobe, u_split, u_dir,
+                                      eta_i, eta_t, &bs))
+                break;
+            beta = f3_mul(beta, bs.weight);
+            if (f3_is_black(beta))
+                break;
+            if (bs.transmit) {
+                if (entering) {
+                    if (med.n < MEDIUM_STACK)
+                        med.obj[med.n++] = p->object;
+                } else {
+                    med.n--;
+                }
+                o = ray_offset(x, f3_neg(n));
+            } else {
+                o = x_out;
+            }
         }
         prev_delta = bs.delta;
         prev_pdf = bs.pdf;
@@ -186,6 +200,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             beta = f3_scale(beta, 1.0f / q);
         }
     }
+    *rays += n_rays;
     if (!isfinite(radiance.x) || !isfinite(radiance.y) || !isfinite(radiance.z))
         return f3_splat(0.0f);
     return radiance;

@@ -16,6 +16,7 @@ typedef float f4 __attribute__((vector_size(16)));
 typedef int32_t i4 __attribute__((vector_size(16)));
 
 static inline f4 f4_splat(float s) { return (f4){s, s, s, s}; }
+static inline i4 i4_splat(int32_t s) { return (i4){s, s, s, s}; }
 
 /* m ? a : b, lane by lane. */
 static inline f4 f4_select(i4 m, f4 a, f4 b)
