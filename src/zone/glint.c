@@ -89,13 +89,14 @@ static double image_irradiance(vec3 x, vec3 n, const vec3 q[3])
 static int path_open(const rscene *rs, vec3 x, vec3 n, vec3 s, vec3 c, int mirror, vec3 y,
                      int light, uint64_t *rays)
 {
-    *rays += 2;
+    (*rays)++;
     vec3f xo = ray_offset(to_f(x), to_f(n));
     vec3 d1 = v3_sub(s, v3(xo.x, xo.y, xo.z));
     double l1 = v3_length(d1);
     if (accel_occluded(rs, xo, to_f(v3_scale(d1, 1.0 / l1)), (float)(l1 * 0.9999),
                        rs->parts[mirror].background))
         return 0;
+    (*rays)++;
     vec3f so = ray_offset(to_f(s), to_f(v3_normalize(v3_sub(s, c))));
     vec3 d2 = v3_sub(y, v3(so.x, so.y, so.z));
     double l2 = v3_length(d2);

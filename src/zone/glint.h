@@ -17,9 +17,12 @@
  * for (mirror or metal, not glass, not a light). */
 int glint_sphere(const rscene *rs, int i);
 
-/* Irradiance at x (unit normal n) from every area light by way of one
- * reflection off a glint sphere, with visibility tested at each small
- * triangle's centre. */
+/* Irradiance at x (unit normal n) from every triangle and sphere light by
+ * way of one reflection off a glint sphere; a triangle light is cut
+ * subdivisions ways along each side, a sphere light's outline has
+ * 4 x subdivisions corners.  Visibility, emission and reflectance are taken
+ * once per light part (at its centre, or a sphere light's point facing the
+ * image). */
 vec3 glint_irradiance(zone_trace *t, vec3 x, vec3 n, int subdivisions);
 
 #endif
