@@ -141,6 +141,7 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
             pl->culled[k] = rp->culled ? 1.0f : 0.0f;
             pl->part[k] = i;
         }
+        rs->point_lights += rp->is_light && rp->shape == SHAPE_POINT;
         double power = rp->is_light ? part_power(rp, &rs->objects[rp->object]) : 0;
         if (power > 0) {
             rp->light = rs->light_count;

@@ -28,8 +28,33 @@
  * or they would not add up to it. */
 #define SIGNATURE_STEPS 16
 
+/* Which point lights light x (normal n, facing the viewer) as bits: a
+ * point light's shadow is hard, and a pixel its edge crosses must be
+ * measured like any other edge, not shaded from one sample. */
+static uint32_t point_light_bits(const rscene *rs, vec3f x, vec3f n, uint64_t *rays)
+{
+    uint32_t bits = 0;
+    int k = 0;
+    vec3f xo = ray_offset(x, n);
+    for (int i = 0; i < rs->part_count && k < 32; i++) {
+        const rs_part *lp = &rs->parts[i];
+        if (!lp->is_light || lp->shape != SHAPE_POINT)
+            continue;
+        vec3f to = f3_sub(lp->p0, xo);
+        float dist = f3_length(to);
+        if (f3_dot(to, n) > 0.0f && dist > 0.0f) {
+            (*rays)++;
+            if (!accel_occluded(rs, xo, f3_scale(to, 1.0f / dist), dist, lp->background))
+                bits |= 1u << k;
+        }
+        k++;
+    }
+    return bits + 1;
+}
+
 /* What a camera ray sees, as a number: the parts along its specular chain
- * (the transmitted branch through glass).  Sub-pixel samples with the same
+ * (the transmitted branch through glass), and which point lights light its
+ * diffuse hits.  Sub-pixel samples with the same
  * signature see one smooth surface; differing ones mark an edge.  *first is
  * the ray's first hit; *curved (unless NULL) is set when the chain meets a
  * sphere, *glint (unless NULL) when it ends on a light after a specular step. */
@@ -52,11 +77,15 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
             *curved = 1;
         if (p->is_light && k > 0 && glint)
             *glint = 1;
-        if (p->is_light || m->weight[LOBE_DIFFUSE] >= 1.0f)
+        if (p->is_light)
             break;
         vec3f x = f3_madd(o, d, h.t);
         vec3f ng = shape_normal(p, x);
         vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
+        if (m->weight[LOBE_DIFFUSE] > 0.0f && rs->point_lights)
+            sig = (sig ^ point_light_bits(rs, x, n, rays)) * 16777619u;
+        if (m->weight[LOBE_DIFFUSE] >= 1.0f)
+            break;
         float cos_o = -f3_dot(d, n);
         /* Follow the refracted branch as it bends: a light seen through
          * glass has its edge where the bent ray leaves it, and the coverage
