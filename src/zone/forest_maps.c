@@ -77,7 +77,7 @@ void forest_scene_bounds(const zt_scene *sc, vec3 *lo, vec3 *hi)
 
 /* A fixed cosine-weighted direction set: a Hammersley point set through
  * the disk-to-hemisphere map. */
-static vec3 *gather_directions(int n)
+vec3 *forest_gather_directions(int n)
 {
     vec3 *d = malloc((size_t)n * sizeof *d);
     if (!d)
@@ -221,6 +221,11 @@ static vec3 sky_texel(zone_trace *t, const zone_forest *f, vec3 x, vec3 n, const
     return v3_scale(v3(rs->sky.x, rs->sky.y, rs->sky.z), 3.14159265358979 * open / f->q.gather);
 }
 
+vec3 forest_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
+{
+    return sky_texel(t, t->f, x, n, t->f->dirs);
+}
+
 /* How much coarser the transfer into texel (u, j) may be: the square root
  * of how many times wider it is than the core's texels.  A texel far out on
  * a plane stands for a large area that matters little; the full width
@@ -334,7 +339,7 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
     }
     free(walls.part);
     f->blockers = transfer_blockers_build(sc);
-    vec3 *dirs = gather_directions(f->q.gather);
+    vec3 *dirs = forest_gather_directions(f->q.gather);
     f->dirs = dirs;
     if (!dirs || !f->blockers)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");

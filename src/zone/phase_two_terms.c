@@ -190,8 +190,9 @@ static vec3 map_value(zone_trace *t, const p2_term *term, const p2_sample *s)
 {
     surface sf;
     surface_of(&t->r->rs, s, &sf);
-    int slot = term->type == P2_SKY_DIRECT ? t->f->sky_slot : term->level - 1;
-    vec3 e = map_lookup_wide(&t->f->maps[s->part], slot, sf.back, sf.x, 0.0);
+    vec3 e = term->type == P2_SKY_DIRECT
+                 ? forest_sky_irradiance(t, sf.x, sf.n)
+                 : map_lookup_wide(&t->f->maps[s->part], term->level - 1, sf.back, sf.x, 0.0);
     return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
 }
 

@@ -82,6 +82,8 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
  * three planes meet; independent of the camera. */
 void forest_scene_bounds(const zt_scene *sc, vec3 *lo, vec3 *hi);
 void forest_free(zone_forest *f);
+/* The fixed gather directions (cosine-weighted, around +z). */
+vec3 *forest_gather_directions(int n);
 
 /* Radiance arriving along a ray with levels lo..hi (flags below). */
 typedef struct zone_trace {
@@ -90,6 +92,11 @@ typedef struct zone_trace {
     uint64_t rays;
     float cone;         /* angular radius a gather ray stands for (0: exact) */
 } zone_trace;
+
+/* The sky's direct irradiance at x (normal n), gathered at x itself over
+ * the forest's directions: camera samples take it here rather than from
+ * the map, which smears it where surfaces meet or cross. */
+vec3 forest_sky_irradiance(zone_trace *t, vec3 x, vec3 n);
 
 enum {
     ZR_EXACT_DIRECT = 1, /* level 1 from the analytic direct term, not maps */

@@ -73,7 +73,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                  * (a gathered quantity) is the level-0 map minus that. */
                 e = v3_add(e, direct_light(t, h.part, x, n));
                 if (t->f->sky_slot >= 0)
-                    e = v3_add(e, map_lookup_wide(pm, t->f->sky_slot, back, x, 0.0));
+                    e = v3_add(e, forest_sky_irradiance(t, x, n));
             } else if (l - 1 < t->f->map_levels) {
                 /* A gather ray's value is an average over its cone's
                  * footprint: read the map at that width. */

@@ -64,6 +64,8 @@ zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err)
         if (st == ZT_OK)
             st = forest_build_maps(f, r, err);
     }
+    if (st == ZT_OK && !f->dirs && !(f->dirs = forest_gather_directions(f->q.gather)))
+        st = zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     f->phase_one_seconds = render_clock() - t0;
     if (!f->loaded)
         f->build_seconds = f->phase_one_seconds;
