@@ -17,8 +17,8 @@ int glint_sphere(const rscene *rs, int i)
     if (p->is_light || p->shape != SHAPE_SPHERE)
         return 0;
     const rs_object *m = &rs->objects[p->object];
-    return m->weight[LOBE_REFRACTIVE] == 0.0f &&
-           (m->weight[LOBE_REFLECTING] > 0.0f || m->weight[LOBE_METALLIC] > 0.0f);
+    return m->weight[LOBE_REFLECTING] > 0.0f || m->weight[LOBE_METALLIC] > 0.0f ||
+           m->weight[LOBE_REFRACTIVE] > 0.0f;
 }
 
 /* The point s on sphere (c, r) where light from y reflects towards x (both
@@ -120,6 +120,10 @@ static vec3 reflected(const rscene *rs, vec3 x, vec3 n, int mirror, int light, v
     double k = m->weight[LOBE_REFLECTING];
     if (m->weight[LOBE_METALLIC] > 0.0f)
         k += m->weight[LOBE_METALLIC] * bsdf_schlick(cos_i, m->ior);
+    /* Glass reflects its Fresnel share off its outside (the receiver is
+     * outside it, in vacuum; what crosses the glass is gathered). */
+    if (m->weight[LOBE_REFRACTIVE] > 0.0f)
+        k += m->weight[LOBE_REFRACTIVE] * bsdf_fresnel_dielectric(cos_i, 1.0f, m->ior);
     vec3f le = light_emitted(rs, &rs->parts[light], to_f(y), to_f(v3_normalize(v3_sub(y, s))));
     return v3_scale(v3(le.x * m->color.x, le.y * m->color.y, le.z * m->color.z), k);
 }

@@ -1,5 +1,5 @@
-/* Light reaching a diffuse point after one reflection off a mirror or metal
- * sphere, computed from the light's image in the sphere instead of by
+/* Light reaching a diffuse point after one reflection off a mirror, metal or
+ * glass sphere, computed from the light's image in the sphere instead of by
  * gathering: that image is small and bright, and a fixed set of gather
  * directions finds it in some texels and misses it in their neighbours.
  * The light is cut into small triangles; each corner is carried to its
@@ -13,8 +13,9 @@
 
 #include "zone/zone_internal.h"
 
-/* Whether part i is a sphere whose reflection glint_irradiance accounts
- * for (mirror or metal, not glass, not a light). */
+/* Whether part i is a sphere whose reflection off its outside
+ * glint_irradiance accounts for (mirror, metal or glass; not a light).
+ * Light through glass is not an image here: it is gathered. */
 int glint_sphere(const rscene *rs, int i);
 
 /* Irradiance at x (unit normal n) from every triangle and sphere light by

@@ -108,7 +108,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         }
         if (k_refl > 0) {
             int rflags = exact_direct;
-            if ((flags & ZR_NO_GLINT) && glint_sphere(rs, h.part))
+            if ((flags & ZR_NO_GLINT) && !back && media_count == 0 && glint_sphere(rs, h.part))
                 rflags |= ZR_NO_EMISSION;
             vec3 l = zone_radiance(t, out_o, refl, lo - 1, hi - 1, rflags, media, media_count);
             out = v3_add(out, v3_scale(v3_mul(color, l), k_refl));
