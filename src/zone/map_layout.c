@@ -19,13 +19,14 @@ static int clampi(double v, int lo, int hi)
 #define OUTER_REACH 64.0
 
 /* Whether no light can reach the open half-space behind plane part q: q
- * hides what is behind it (culled and opaque) and every light lies in
- * front of it. */
+ * is opaque and every light lies in front of it.  Culled or not makes no
+ * difference here: light from the front stops at it either way, and an
+ * infinite plane has no edge to pass around. */
 static int walls_off(const zt_scene *sc, int q)
 {
     const part *pq = &sc->parts[q];
     const object *oq = &sc->objects[pq->object];
-    if (pq->shape != SHAPE_PLANE || !oq->backculled || oq->is_light ||
+    if (pq->shape != SHAPE_PLANE || oq->is_light ||
         oq->mat.weight[LOBE_REFRACTIVE] > 0 || (sc->sky.x > 0 || sc->sky.y > 0 || sc->sky.z > 0))
         return 0;
     for (int i = 0; i < sc->part_count; i++) {
