@@ -6,8 +6,8 @@
 
 #include "geom/accel.h"
 #include "util/error.h"
+#include "util/vec3_convert.h"
 
-static vec3f to_f(vec3 v) { return f3((float)v.x, (float)v.y, (float)v.z); }
 
 static int light_is_off(int index, const int *off, int n)
 {
@@ -39,14 +39,14 @@ static void fill_part(rs_part *rp, const part *p, const object *o)
     rp->background = (uint8_t)o->background;
     rp->object = p->object;
     rp->light = -1;
-    rp->p0 = to_f(p->p[0]);
+    rp->p0 = v3_to_f3(p->p[0]);
     switch (p->shape) {
     case SHAPE_TRIANGLE: {
         vec3 e1 = v3_sub(p->p[1], p->p[0]), e2 = v3_sub(p->p[2], p->p[0]);
         vec3 c = v3_cross(e1, e2);
-        rp->e1 = to_f(e1);
-        rp->e2 = to_f(e2);
-        rp->n = to_f(v3_normalize(c));
+        rp->e1 = v3_to_f3(e1);
+        rp->e2 = v3_to_f3(e2);
+        rp->n = v3_to_f3(v3_normalize(c));
         rp->area = (float)(0.5 * v3_length(c));
         f3_basis(rp->n, &rp->tangent, &rp->bitangent);
         break;
@@ -56,7 +56,7 @@ static void fill_part(rs_part *rp, const part *p, const object *o)
         rp->area = (float)(4 * 3.14159265358979 * p->radius * p->radius);
         break;
     case SHAPE_PLANE:
-        rp->n = to_f(p->normal);
+        rp->n = v3_to_f3(p->normal);
         rp->offset = (float)p->offset;
         f3_basis(rp->n, &rp->tangent, &rp->bitangent);
         break;
@@ -106,7 +106,7 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
         rscene_free(rs);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     }
-    rs->sky = to_f(scene->sky);
+    rs->sky = v3_to_f3(scene->sky);
 
     for (int i = 0; i < scene->object_count; i++) {
         const object *o = &scene->objects[i];
@@ -117,13 +117,13 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
             lobes += ro->weight[k] > 0.0f;
         }
         ro->lobe_choice = lobes > 1;
-        ro->color = to_f(o->mat.color);
+        ro->color = v3_to_f3(o->mat.color);
         ro->ior = (float)o->mat.ior;
         ro->is_light = (uint8_t)o->is_light;
         ro->culled = (uint8_t)o->backculled;
         ro->background = (uint8_t)o->background;
         if (o->is_light && !light_is_off(o->index, lights_off, lights_off_count))
-            ro->emission = to_f(o->emission);
+            ro->emission = v3_to_f3(o->emission);
     }
 
     double total = 0;

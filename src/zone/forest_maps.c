@@ -11,6 +11,7 @@
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
 #include "util/error.h"
+#include "util/vec3_convert.h"
 #include "zone/glint.h"
 #include "zone/map_layout.h"
 #include "zone/transfer.h"
@@ -103,7 +104,6 @@ static void frame(vec3 n, vec3 *t, vec3 *b)
     *b = v3_cross(n, *t);
 }
 
-static vec3f to_f(vec3 v) { return f3((float)v.x, (float)v.y, (float)v.z); }
 
 /* Direct irradiance (every light, exact) at point x of a part. */
 static vec3 direct_light_at(zone_trace *t, int part_index, vec3 x, vec3 n)
@@ -145,7 +145,7 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
      * level 0; specular surfaces and spheres above). */
     vec3 tt, bb;
     frame(n, &tt, &bb);
-    vec3f o = ray_offset(to_f(x), to_f(n));
+    vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
     vec3 sum = v3(0, 0, 0);
     /* Each direction stands for a cone of solid angle about 2 pi / N. */
     t->cone = (float)sqrt(2.0 / f->q.gather);
@@ -154,11 +154,11 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
                         v3_scale(n, dirs[k].z));
         vec3 l;
         if (level == 0) {
-            hit h = accel_intersect(rs, o, to_f(d));
+            hit h = accel_intersect(rs, o, v3_to_f3(d));
             t->rays++;
             l = h.part < 0 ? v3(rs->sky.x, rs->sky.y, rs->sky.z) : v3(0, 0, 0);
         } else {
-            l = zone_radiance(t, o, to_f(v3_normalize(d)), level, level,
+            l = zone_radiance(t, o, v3_to_f3(v3_normalize(d)), level, level,
                               ZR_SKIP_FLAT_DIFFUSE | ZR_NO_GLINT, NULL, 0);
         }
         sum = v3_add(sum, l);
@@ -174,11 +174,11 @@ static float texel_weight(const rscene *rs, int own, vec3 x, vec3 n, const vec3 
 {
     vec3 t, b;
     frame(n, &t, &b);
-    vec3f o = ray_offset(to_f(x), to_f(n));
+    vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
     int inside = 0, step = ndirs / 8 > 0 ? ndirs / 8 : 1, count = 0;
     for (int k = 0; k < ndirs; k += step) {
         vec3 dd = v3_add(v3_add(v3_scale(t, dirs[k].x), v3_scale(b, dirs[k].y)), v3_scale(n, dirs[k].z));
-        vec3f d = to_f(v3_normalize(dd));
+        vec3f d = v3_to_f3(v3_normalize(dd));
         float best = 1e30f;
         int hit_part = -1;
         for (int i = 0; i < rs->part_count; i++) {
@@ -209,12 +209,12 @@ static vec3 sky_texel(zone_trace *t, const zone_forest *f, vec3 x, vec3 n, const
     const rscene *rs = &t->r->rs;
     vec3 tt, bb;
     frame(n, &tt, &bb);
-    vec3f o = ray_offset(to_f(x), to_f(n));
+    vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
     int open = 0;
     for (int k = 0; k < f->q.gather; k++) {
         vec3 d = v3_add(v3_add(v3_scale(tt, dirs[k].x), v3_scale(bb, dirs[k].y)),
                         v3_scale(n, dirs[k].z));
-        hit h = accel_intersect(rs, o, to_f(d));
+        hit h = accel_intersect(rs, o, v3_to_f3(d));
         t->rays++;
         open += h.part < 0;
     }

@@ -5,11 +5,11 @@
 #include "light/light_sample.h"
 #include "material/bsdf.h"
 #include "zone/lambert.h"
+#include "util/vec3_convert.h"
 
 #define DISK_SIDES_MAX 32  /* a sphere light's outline, as seen from its image */
 #define BISECT_STEPS 32    /* the specular point to about 1e-10 of the arc */
 
-static vec3f to_f(vec3 v) { return f3((float)v.x, (float)v.y, (float)v.z); }
 
 int glint_sphere(const rscene *rs, int i)
 {
@@ -90,17 +90,17 @@ static int path_open(const rscene *rs, vec3 x, vec3 n, vec3 s, vec3 c, int mirro
                      int light, uint64_t *rays)
 {
     (*rays)++;
-    vec3f xo = ray_offset(to_f(x), to_f(n));
-    vec3 d1 = v3_sub(s, v3(xo.x, xo.y, xo.z));
+    vec3f xo = ray_offset(v3_to_f3(x), v3_to_f3(n));
+    vec3 d1 = v3_sub(s, f3_to_v3(xo));
     double l1 = v3_length(d1);
-    if (accel_occluded(rs, xo, to_f(v3_scale(d1, 1.0 / l1)), (float)(l1 * 0.9999),
+    if (accel_occluded(rs, xo, v3_to_f3(v3_scale(d1, 1.0 / l1)), (float)(l1 * 0.9999),
                        rs->parts[mirror].background))
         return 0;
     (*rays)++;
-    vec3f so = ray_offset(to_f(s), to_f(v3_normalize(v3_sub(s, c))));
-    vec3 d2 = v3_sub(y, v3(so.x, so.y, so.z));
+    vec3f so = ray_offset(v3_to_f3(s), v3_to_f3(v3_normalize(v3_sub(s, c))));
+    vec3 d2 = v3_sub(y, f3_to_v3(so));
     double l2 = v3_length(d2);
-    return !accel_occluded(rs, so, to_f(v3_scale(d2, 1.0 / l2)), (float)(l2 * 0.9999),
+    return !accel_occluded(rs, so, v3_to_f3(v3_scale(d2, 1.0 / l2)), (float)(l2 * 0.9999),
                            rs->parts[light].background);
 }
 
@@ -112,7 +112,7 @@ static vec3 reflected(const rscene *rs, vec3 x, vec3 n, int mirror, int light, v
 {
     const rs_part *sp = &rs->parts[mirror];
     const rs_object *m = &rs->objects[sp->object];
-    vec3 c = v3(sp->p0.x, sp->p0.y, sp->p0.z), s;
+    vec3 c = f3_to_v3(sp->p0), s;
     if (!specular_point(c, sp->radius, x, y, &s) || !path_open(rs, x, n, s, c, mirror, y, light, rays))
         return v3(0, 0, 0);
     vec3 ns = v3_normalize(v3_sub(s, c));
@@ -124,7 +124,7 @@ static vec3 reflected(const rscene *rs, vec3 x, vec3 n, int mirror, int light, v
      * outside it, in vacuum; what crosses the glass is gathered). */
     if (m->weight[LOBE_REFRACTIVE] > 0.0f)
         k += m->weight[LOBE_REFRACTIVE] * bsdf_fresnel_dielectric(cos_i, 1.0f, m->ior);
-    vec3f le = light_emitted(rs, &rs->parts[light], to_f(y), to_f(v3_normalize(v3_sub(y, s))));
+    vec3f le = light_emitted(rs, &rs->parts[light], v3_to_f3(y), v3_to_f3(v3_normalize(v3_sub(y, s))));
     return v3_scale(v3(le.x * m->color.x, le.y * m->color.y, le.z * m->color.z), k);
 }
 
@@ -138,7 +138,7 @@ static vec3 light_triangle(const rscene *rs, vec3 x, vec3 nx, int mirror, int li
                            const vec3 v[3], int n, uint64_t *rays)
 {
     const rs_part *sp = &rs->parts[mirror];
-    vec3 c = v3(sp->p0.x, sp->p0.y, sp->p0.z);
+    vec3 c = f3_to_v3(sp->p0);
     if (n > CUTS_MAX)
         n = CUTS_MAX;
     vec3 s[CUTS_MAX + 1][CUTS_MAX + 1];
@@ -174,7 +174,7 @@ static vec3 light_sphere(const rscene *rs, vec3 x, vec3 nx, int mirror, int ligh
 {
 
     const rs_part *lp = &rs->parts[light], *sp = &rs->parts[mirror];
-    vec3 cl = v3(lp->p0.x, lp->p0.y, lp->p0.z), c = v3(sp->p0.x, sp->p0.y, sp->p0.z), s0;
+    vec3 cl = f3_to_v3(lp->p0), c = f3_to_v3(sp->p0), s0;
     double rl = lp->radius;
     if (!specular_point(c, sp->radius, x, cl, &s0))
         return v3(0, 0, 0);
@@ -218,7 +218,7 @@ vec3 glint_irradiance(zone_trace *t, vec3 x, vec3 n, int subdivisions)
         if (!glint_sphere(rs, mi))
             continue;
         const rs_part *sp = &rs->parts[mi];
-        vec3 c = v3(sp->p0.x, sp->p0.y, sp->p0.z);
+        vec3 c = f3_to_v3(sp->p0);
         /* Nothing of the sphere above x's horizon, or x inside it. */
         if (v3_dot(n, v3_sub(c, x)) <= -sp->radius || v3_length(v3_sub(c, x)) <= sp->radius)
             continue;
@@ -227,9 +227,9 @@ vec3 glint_irradiance(zone_trace *t, vec3 x, vec3 n, int subdivisions)
             if (!lp->is_light || f3_is_black(rs->objects[lp->object].emission))
                 continue;
             if (lp->shape == SHAPE_TRIANGLE) {
-                vec3 p0 = v3(lp->p0.x, lp->p0.y, lp->p0.z);
-                vec3 v[3] = {p0, v3_add(p0, v3(lp->e1.x, lp->e1.y, lp->e1.z)),
-                             v3_add(p0, v3(lp->e2.x, lp->e2.y, lp->e2.z))};
+                vec3 p0 = f3_to_v3(lp->p0);
+                vec3 v[3] = {p0, v3_add(p0, f3_to_v3(lp->e1)),
+                             v3_add(p0, f3_to_v3(lp->e2))};
                 e = v3_add(e, light_triangle(rs, x, n, mi, li, v, subdivisions, &t->rays));
             } else if (lp->shape == SHAPE_SPHERE) {
                 e = v3_add(e, light_sphere(rs, x, n, mi, li, subdivisions, &t->rays));

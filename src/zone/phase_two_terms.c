@@ -15,11 +15,11 @@
 #include "geom/shapes.h"
 #include "material/bsdf.h"
 #include "util/error.h"
+#include "util/vec3_convert.h"
 #include "zone/phase_two.h"
 
 #define SHADE_FLAGS (ZR_EXACT_DIRECT | ZR_NO_EMISSION)
 
-static vec3 to_d(vec3f v) { return v3(v.x, v.y, v.z); }
 
 static int push_term(p2_terms *t, int *cap, p2_term term)
 {
@@ -168,9 +168,9 @@ static void surface_of(const rscene *rs, const p2_sample *s, surface *sf)
     vec3f ngf = shape_normal(sf->p, sf->xf);
     sf->back = f3_dot(ngf, s->d) > 0.0f;
     sf->nf = sf->back ? f3_neg(ngf) : ngf;
-    sf->x = to_d(sf->xf);
-    sf->n = to_d(sf->nf);
-    sf->color = to_d(sf->m->color);
+    sf->x = f3_to_v3(sf->xf);
+    sf->n = f3_to_v3(sf->nf);
+    sf->color = f3_to_v3(sf->m->color);
 }
 
 /* Level 1 diffuse light from one light part. */
@@ -181,7 +181,7 @@ static vec3 direct_value(zone_trace *t, const p2_term *term, const p2_sample *s)
     surface_of(rs, s, &sf);
     vec3f em = rs->objects[rs->parts[term->light].object].emission;
     double g = direct_irradiance(&t->f->direct, term->light, sf.x, sf.n, s->part);
-    vec3 e = v3_scale(to_d(em), g);
+    vec3 e = v3_scale(f3_to_v3(em), g);
     return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
 }
 
@@ -251,7 +251,7 @@ static vec3 root_value(const p2_ctx *c, zone_trace *t, int i, const p2_pixel *px
     int light = px->lights[i];
     vec3f e = rs->objects[rs->parts[light].object].emission;
     if (px->light_cover[i] >= 0)
-        return v3_scale(to_d(e), px->light_cover[i]);
+        return v3_scale(f3_to_v3(e), px->light_cover[i]);
     vec3 corner[4];
     const float cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
     for (int i = 0; i < 4; i++) {
@@ -259,9 +259,9 @@ static vec3 root_value(const p2_ctx *c, zone_trace *t, int i, const p2_pixel *px
         cam_ray(&c->c, (float)px->x + cx[i], (float)px->y + cy[i], &o, &d);
         corner[i] = v3(o.x, o.y, o.z);
     }
-    vec3 eye = to_d(c->c.viewpoint);
+    vec3 eye = f3_to_v3(c->c.viewpoint);
     double cov = direct_pixel_coverage(&t->f->direct, light, eye, corner);
-    return v3_scale(to_d(e), cov);
+    return v3_scale(f3_to_v3(e), cov);
 }
 
 static void add(double acc[3], double w, vec3 v)
@@ -283,7 +283,7 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
             }
         return;
     case P2_SKY: {
-        vec3 sky = to_d(t->r->rs.sky);
+        vec3 sky = f3_to_v3(t->r->rs.sky);
         for (int i = 0; i < px->n; i++)
             if (px->s[i].part < 0)
                 add(acc, px->s[i].w, sky);

@@ -13,11 +13,11 @@
 #include "geom/shapes.h"
 #include "light/light_sample.h"
 #include "material/bsdf.h"
+#include "util/vec3_convert.h"
 #include "zone/glint.h"
 
 #define MEDIA_MAX 8
 
-static vec3 to_d(vec3f v) { return v3(v.x, v.y, v.z); }
 
 static vec3 direct_light(zone_trace *t, int receiver, vec3 x, vec3 n)
 {
@@ -31,7 +31,7 @@ static vec3 direct_light(zone_trace *t, int receiver, vec3 x, vec3 n)
         if (f3_is_black(em))
             continue;
         double g = direct_irradiance(&t->f->direct, i, x, n, receiver);
-        e = v3_add(e, v3_scale(to_d(em), g));
+        e = v3_add(e, v3_scale(f3_to_v3(em), g));
     }
     return e;
 }
@@ -47,11 +47,11 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
     hit h = accel_intersect(rs, o, d);
     t->rays++;
     if (h.part < 0)
-        return lo <= 0 ? to_d(rs->sky) : v3(0, 0, 0);
+        return lo <= 0 ? f3_to_v3(rs->sky) : v3(0, 0, 0);
     const rs_part *p = &rs->parts[h.part];
     vec3f xf = f3_madd(o, d, h.t);
     if (p->is_light)
-        return lo <= 0 && !(flags & ZR_NO_EMISSION) ? to_d(light_emitted(rs, p, xf, d))
+        return lo <= 0 && !(flags & ZR_NO_EMISSION) ? f3_to_v3(light_emitted(rs, p, xf, d))
                                                      : v3(0, 0, 0);
     if (hi < 1)
         return v3(0, 0, 0);
@@ -60,7 +60,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
     vec3f ngf = shape_normal(p, xf);
     int back = f3_dot(ngf, d) > 0.0f;
     vec3f nf = back ? f3_neg(ngf) : ngf;
-    vec3 x = to_d(xf), n = to_d(nf), color = to_d(m->color);
+    vec3 x = f3_to_v3(xf), n = f3_to_v3(nf), color = f3_to_v3(m->color);
     vec3 out = v3(0, 0, 0);
 
     int skip_diffuse = (flags & ZR_SKIP_FLAT_DIFFUSE) && p->shape != SHAPE_SPHERE;
