@@ -99,10 +99,11 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
     rs->parts = calloc((size_t)(scene->part_count + 1), sizeof(rs_part));
     rs->objects = calloc((size_t)(scene->object_count + 1), sizeof(rs_object));
     rs->lights = calloc((size_t)(scene->part_count + 1), sizeof(rs_light));
+    rs->point_lights = calloc((size_t)(scene->part_count + 1), sizeof(int));
     int planes_ok = 1;
     for (int l = 0; l < 2; l++)
         planes_ok &= planes_alloc(&rs->planes[l], scene, l);
-    if (!rs->parts || !rs->objects || !rs->lights || !planes_ok) {
+    if (!rs->parts || !rs->objects || !rs->lights || !rs->point_lights || !planes_ok) {
         rscene_free(rs);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     }
@@ -141,7 +142,8 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
             pl->culled[k] = rp->culled ? 1.0f : 0.0f;
             pl->part[k] = i;
         }
-        rs->point_lights += rp->is_light && rp->shape == SHAPE_POINT;
+        if (rp->is_light && rp->shape == SHAPE_POINT)
+            rs->point_lights[rs->point_light_count++] = i;
         double power = rp->is_light ? part_power(rp, &rs->objects[rp->object]) : 0;
         if (power > 0) {
             rp->light = rs->light_count;
@@ -173,6 +175,7 @@ void rscene_free(rscene *rs)
     free(rs->parts);
     free(rs->objects);
     free(rs->lights);
+    free(rs->point_lights);
     for (int l = 0; l < 2; l++) {
         free(rs->planes[l].nx);
         free(rs->planes[l].part);

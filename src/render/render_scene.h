@@ -66,7 +66,8 @@ typedef struct rscene {
     int object_count;
     rs_light *lights;   /* parts sampled by next-event estimation */
     int light_count;
-    int point_lights;   /* point-light parts, switched off or not */
+    int *point_lights;  /* point-light parts, switched off or not */
+    int point_light_count;
     /* Infinite planes of each layer ([0] foreground, [1] background), kept
      * apart from the other primitives as compact arrays: they are tested
      * against every ray. */

@@ -34,12 +34,9 @@
 static uint32_t point_light_bits(const rscene *rs, vec3f x, vec3f n, uint64_t *rays)
 {
     uint32_t bits = 0;
-    int k = 0;
     vec3f xo = ray_offset(x, n);
-    for (int i = 0; i < rs->part_count && k < 32; i++) {
-        const rs_part *lp = &rs->parts[i];
-        if (!lp->is_light || lp->shape != SHAPE_POINT)
-            continue;
+    for (int k = 0; k < rs->point_light_count && k < 32; k++) {
+        const rs_part *lp = &rs->parts[rs->point_lights[k]];
         vec3f to = f3_sub(lp->p0, xo);
         float dist = f3_length(to);
         if (f3_dot(to, n) > 0.0f && dist > 0.0f) {
@@ -47,7 +44,6 @@ static uint32_t point_light_bits(const rscene *rs, vec3f x, vec3f n, uint64_t *r
             if (!accel_occluded(rs, xo, f3_scale(to, 1.0f / dist), dist, lp->background))
                 bits |= 1u << k;
         }
-        k++;
     }
     return bits + 1;
 }
@@ -82,7 +78,7 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
         vec3f x = f3_madd(o, d, h.t);
         vec3f ng = shape_normal(p, x);
         vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
-        if (m->weight[LOBE_DIFFUSE] > 0.0f && rs->point_lights)
+        if (m->weight[LOBE_DIFFUSE] > 0.0f && rs->point_light_count)
             sig = (sig ^ point_light_bits(rs, x, n, rays)) * 16777619u;
         if (m->weight[LOBE_DIFFUSE] >= 1.0f)
             break;
