@@ -83,13 +83,14 @@ static void test_image_matches_integral(void **state)
     assert_int_equal(zt_renderer_create(s, &o, &r, &err), ZT_OK);
     zone_trace t = {NULL, r, 0, 0.0f};
     assert_true(glint_sphere(&r->rs, 1));
+    const int mirror[1] = {1};
 
     const vec3 xs[3] = {{2.5, 0.5, 0.3}, {-1.5, -0.5, 2.0}, {0.4, 1.9, -1.8}};
     for (int k = 0; k < 3; k++) {
         vec3 x = xs[k], n = v3_normalize(v3_scale(x, -1.0));
         double ref = numeric(x, n, 3000);
-        double coarse = glint_irradiance(&t, x, n, 2).x;
-        double fine = glint_irradiance(&t, x, n, 8).x;
+        double coarse = glint_irradiance(&t, mirror, 1, x, n, 2).x;
+        double fine = glint_irradiance(&t, mirror, 1, x, n, 8).x;
         printf("receiver %d: integral %.6g, image cut 2: %.6g, cut 8: %.6g\n", k, ref, coarse, fine);
         assert_true(ref > 0);
         /* The image's straight edges are the only discretisation: within
@@ -99,7 +100,7 @@ static void test_image_matches_integral(void **state)
     }
     /* A receiver facing away sees nothing of the sphere. */
     vec3 x = xs[0];
-    assert_true(glint_irradiance(&t, x, v3_normalize(x), 8).x == 0.0);
+    assert_true(glint_irradiance(&t, mirror, 1, x, v3_normalize(x), 8).x == 0.0);
 
     zt_renderer_release(r);
     zt_scene_release(s);

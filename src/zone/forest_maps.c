@@ -135,8 +135,9 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
         /* Flat diffuse surfaces by exact transfer over their maps; lights
          * in mirror spheres by their images. */
         e = transfer_irradiance(t, part_index, x, n, level, theta);
-        if (level == 1 && f->glints)
-            e = v3_add(e, glint_irradiance(t, x, n, f->q.glint_cuts));
+        if (level == 1 && f->glint_count)
+            e = v3_add(e, glint_irradiance(t, f->glint_spheres, f->glint_count, x, n,
+                                           f->q.glint_cuts));
         if (!f->need_gather)
             return e;
     }
@@ -346,9 +347,13 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
     /* Gathers are needed for what transfer does not cover: light arriving
      * from specular surfaces or diffuse spheres. */
     f->need_gather = 0;
-    f->glints = 0;
+    f->glint_spheres = malloc(((size_t)r->rs.part_count + 1) * sizeof(int));
+    if (!f->glint_spheres)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    f->glint_count = 0;
     for (int i = 0; i < r->rs.part_count; i++)
-        f->glints |= glint_sphere(&r->rs, i);
+        if (glint_sphere(&r->rs, i))
+            f->glint_spheres[f->glint_count++] = i;
     for (int i = 0; i < sc->part_count; i++) {
         const object *o = &sc->objects[sc->parts[i].object];
         if (o->is_light)
@@ -428,6 +433,7 @@ void forest_free(zone_forest *f)
             map_free(&f->maps[i]);
     free(f->maps);
     free(f->dirs);
+    free(f->glint_spheres);
     transfer_blockers_free(f->blockers);
     free(f->zones);
     free(f->occluders);

@@ -210,22 +210,21 @@ static vec3 light_sphere(const rscene *rs, vec3 x, vec3 nx, int mirror, int ligh
     return v3_scale(reflected(rs, x, nx, mirror, light, v3_sub(cl, v3_scale(w, rl)), rays), g);
 }
 
-vec3 glint_irradiance(zone_trace *t, vec3 x, vec3 n, int subdivisions)
+vec3 glint_irradiance(zone_trace *t, const int *spheres, int sphere_count, vec3 x, vec3 n,
+                      int subdivisions)
 {
     const rscene *rs = &t->r->rs;
     vec3 e = v3(0, 0, 0);
-    for (int mi = 0; mi < rs->part_count; mi++) {
-        if (!glint_sphere(rs, mi))
-            continue;
+    for (int k = 0; k < sphere_count; k++) {
+        int mi = spheres[k];
         const rs_part *sp = &rs->parts[mi];
         vec3 c = f3_to_v3(sp->p0);
         /* Nothing of the sphere above x's horizon, or x inside it. */
         if (v3_dot(n, v3_sub(c, x)) <= -sp->radius || v3_length(v3_sub(c, x)) <= sp->radius)
             continue;
-        for (int li = 0; li < rs->part_count; li++) {
+        for (int j = 0; j < rs->light_count; j++) {
+            int li = rs->lights[j].part;
             const rs_part *lp = &rs->parts[li];
-            if (!lp->is_light || f3_is_black(rs->objects[lp->object].emission))
-                continue;
             if (lp->shape == SHAPE_TRIANGLE) {
                 vec3 p0 = f3_to_v3(lp->p0);
                 vec3 v[3] = {p0, v3_add(p0, f3_to_v3(lp->e1)),

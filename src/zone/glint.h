@@ -18,12 +18,13 @@
  * Light through glass is not an image here: it is gathered. */
 int glint_sphere(const rscene *rs, int i);
 
-/* Irradiance at x (unit normal n) from every triangle and sphere light by
- * way of one reflection off a glint sphere; a triangle light is cut
- * subdivisions ways along each side, a sphere light's outline has
- * 4 x subdivisions corners.  Visibility, emission and reflectance are taken
- * once per light part (at its centre, or a sphere light's point facing the
- * image). */
-vec3 glint_irradiance(zone_trace *t, vec3 x, vec3 n, int subdivisions);
+/* Irradiance at x (unit normal n) from every emitting triangle and sphere
+ * light (rs->lights) by way of one reflection off the glint spheres
+ * spheres[0..sphere_count-1]; a triangle light is cut subdivisions ways
+ * along each side, a sphere light's outline has 4 x subdivisions corners.
+ * Visibility, emission and reflectance are taken once per light part (at
+ * its centre, or a sphere light's point facing the image). */
+vec3 glint_irradiance(zone_trace *t, const int *spheres, int sphere_count, vec3 x, vec3 n,
+                      int subdivisions);
 
 #endif

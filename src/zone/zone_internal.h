@@ -61,7 +61,8 @@ typedef struct zone_forest {
     direct_ctx direct;
     zone_quality q;
     int need_gather;    /* some light arrives by specular surfaces or spheres */
-    int glints;         /* some sphere reflects lights as images (glint.h) */
+    int *glint_spheres; /* spheres that reflect lights as images (glint.h) */
+    int glint_count;
     vec3 *dirs;         /* the gather directions (q.gather of them) */
     transfer_blockers *blockers; /* Phase One: what may hide a piece */
     double phase_one_seconds;
