@@ -59,7 +59,6 @@ typedef struct p2_row {
     size_t *light_first;        /* width + 1 offsets into lights */
     uint32_t *corner;           /* scratch: corner signatures */
     int *corner_part;
-    struct edge_grid *edge;     /* scratch: an edge pixel's coverage grid */
     int width;
 } p2_row;
 

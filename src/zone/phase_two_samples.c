@@ -181,7 +181,7 @@ static int grid_samples(const p2_ctx *c, int px, int py, int g, uint32_t first,
     return 1;
 }
 
-/* Scratch for one edge pixel's coverage grid, kept with the row. */
+/* Scratch for one edge pixel's coverage grid (about 112 KB). */
 typedef struct edge_grid {
     uint32_t sig[FINE_GRID * FINE_GRID], group_sig[FINE_GRID * FINE_GRID];
     hit hits[FINE_GRID * FINE_GRID];
@@ -278,7 +278,7 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
 
 /* The samples of pixel (px, py) given its corner signatures. */
 static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners[4],
-                         seen_lights *lights, p2_row *row, uint64_t *rays)
+                         seen_lights *lights, p2_row *row, edge_grid **scratch, uint64_t *rays)
 {
     int g = c->g;
     uint32_t first = corners[0];
@@ -299,10 +299,10 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
         return 1;
     row->sample_count = start;
 
-    if (!row->edge && !(row->edge = malloc(sizeof(edge_grid))))
+    if (!*scratch && !(*scratch = malloc(sizeof(edge_grid))))
         return 0;
     int glint = 0, rim = 0;
-    if (!edge_samples(c, px, py, EDGE_GRID, EDGE_SHADE, row->edge, lights, row, rays, &glint,
+    if (!edge_samples(c, px, py, EDGE_GRID, EDGE_SHADE, *scratch, lights, row, rays, &glint,
                       &rim, 0))
         return 0;
     if (glint || rim) {
@@ -314,7 +314,7 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
          * outlines the sphere by a polygon, the grid by rays; the two would
          * leave slivers between them, so both come from the fine grid. */
         row->sample_count = start;
-        if (!edge_samples(c, px, py, FINE_GRID, FINE_SHADE, row->edge, lights, row, rays,
+        if (!edge_samples(c, px, py, FINE_GRID, FINE_SHADE, *scratch, lights, row, rays,
                           &glint, &rim, rim))
             return 0;
     }
@@ -336,6 +336,9 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
     }
     row->sample_count = 0;
     row->light_count = 0;
+    /* Edge pixels' grids: scratch for this row only, as the zone strategy
+     * keeps every row of the image. */
+    edge_grid *scratch = NULL;
     /* Signatures at the pixel corners of this row (top and bottom). */
     for (int k = 0; k < 2 * w1; k++) {
         vec3f org, dir;
@@ -354,9 +357,13 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         note_light(rs, &lights, row->corner_part[w1 + x + 1]);
         row->pixel_first[x] = row->sample_count;
         row->light_first[x] = row->light_count;
-        if (!pixel_samples(c, x, y, cs, &lights, row, rays) || !push_lights(row, &lights))
+        if (!pixel_samples(c, x, y, cs, &lights, row, &scratch, rays) ||
+            !push_lights(row, &lights)) {
+            free(scratch);
             return 0;
+        }
     }
+    free(scratch);
     row->pixel_first[w] = row->sample_count;
     row->light_first[w] = row->light_count;
     return 1;
@@ -371,6 +378,5 @@ void p2_row_free(p2_row *row)
     free(row->light_first);
     free(row->corner);
     free(row->corner_part);
-    free(row->edge);
     memset(row, 0, sizeof *row);
 }
