@@ -21,12 +21,10 @@ int glint_sphere(const rscene *rs, int i)
            m->weight[LOBE_REFRACTIVE] > 0.0f;
 }
 
-/* The point s on sphere (c, r) where light from y reflects towards x (both
- * outside): in the plane of c, x and y, the angle phi of s runs from x's
- * direction to y's, and at s the unit vectors to x and y have no component
- * along the tangent.  Returns 0 when the reflection would be at or past
- * grazing for either point. */
-static int specular_point(vec3 c, double r, vec3 x, vec3 y, vec3 *s)
+/* In the plane of c, x and y, the angle phi of s runs from x's direction
+ * to y's, and at s the unit vectors to x and y have no component along the
+ * tangent: bisection on phi. */
+int glint_specular_point(vec3 c, double r, vec3 x, vec3 y, vec3 *s)
 {
     vec3 px = v3_sub(x, c), py = v3_sub(y, c);
     double lx = v3_length(px);
@@ -113,7 +111,7 @@ static vec3 reflected(const rscene *rs, vec3 x, vec3 n, int mirror, int light, v
     const rs_part *sp = &rs->parts[mirror];
     const rs_object *m = &rs->objects[sp->object];
     vec3 c = f3_to_v3(sp->p0), s;
-    if (!specular_point(c, sp->radius, x, y, &s) || !path_open(rs, x, n, s, c, mirror, y, light, rays))
+    if (!glint_specular_point(c, sp->radius, x, y, &s) || !path_open(rs, x, n, s, c, mirror, y, light, rays))
         return v3(0, 0, 0);
     vec3 ns = v3_normalize(v3_sub(s, c));
     float cos_i = (float)v3_dot(ns, v3_normalize(v3_sub(x, s)));
@@ -147,7 +145,10 @@ static vec3 light_triangle(const rscene *rs, vec3 x, vec3 nx, int mirror, int li
     for (int i = 0; i <= n; i++)
         for (int j = 0; i + j <= n; j++) {
             vec3 y = v3_add(v[0], v3_add(v3_scale(e1, i), v3_scale(e2, j)));
-            ok[i][j] = (unsigned char)specular_point(c, sp->radius, x, y, &s[i][j]);
+            /* A light may pierce the sphere: its points inside have no
+             * image on the outside. */
+            ok[i][j] = v3_length(v3_sub(y, c)) > sp->radius &&
+                       glint_specular_point(c, sp->radius, x, y, &s[i][j]);
         }
     double g = 0;
     for (int i = 0; i < n; i++)
@@ -176,7 +177,7 @@ static vec3 light_sphere(const rscene *rs, vec3 x, vec3 nx, int mirror, int ligh
     const rs_part *lp = &rs->parts[light], *sp = &rs->parts[mirror];
     vec3 cl = f3_to_v3(lp->p0), c = f3_to_v3(sp->p0), s0;
     double rl = lp->radius;
-    if (!specular_point(c, sp->radius, x, cl, &s0))
+    if (!glint_specular_point(c, sp->radius, x, cl, &s0))
         return v3(0, 0, 0);
     vec3 d = v3_sub(cl, s0);
     double dist = v3_length(d);
@@ -191,11 +192,11 @@ static vec3 light_sphere(const rscene *rs, vec3 x, vec3 nx, int mirror, int ligh
     double step = 2.0 * 3.14159265358979323846 / sides;
     double re = orad * sqrt(step / sin(step)); /* a polygon of the disk's area */
     vec3 ring[DISK_SIDES_MAX], sc;
-    if (!specular_point(c, sp->radius, x, oc, &sc))
+    if (!glint_specular_point(c, sp->radius, x, oc, &sc))
         return v3(0, 0, 0);
     for (int i = 0; i < sides; i++) {
         vec3 y = v3_add(oc, v3_add(v3_scale(u, re * cos(i * step)), v3_scale(v, re * sin(i * step))));
-        if (!specular_point(c, sp->radius, x, y, &ring[i]))
+        if (!glint_specular_point(c, sp->radius, x, y, &ring[i]))
             return v3(0, 0, 0);
     }
     double g = 0;

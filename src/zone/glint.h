@@ -18,6 +18,11 @@
  * Light through glass is not an image here: it is gathered. */
 int glint_sphere(const rscene *rs, int i);
 
+/* The point *s on sphere (c, r) where light from y reflects towards x (both
+ * outside).  Returns 0 when the reflection would be at or past grazing for
+ * either point. */
+int glint_specular_point(vec3 c, double r, vec3 x, vec3 y, vec3 *s);
+
 /* Irradiance at x (unit normal n) from every emitting triangle and sphere
  * light (rs->lights) by way of one reflection off the glint spheres
  * spheres[0..sphere_count-1]; a triangle light is cut subdivisions ways

@@ -106,7 +106,25 @@ typedef struct p2_ctx {
     int lo, hi;         /* levels rendered */
     int g;              /* sub-pixel grid of smooth pixels */
     p2_terms terms;
+    const struct p2_marks *marks; /* what the pixels' own rays may miss */
 } p2_ctx;
+
+/* What the pixels' own rays may miss, found from the eye
+ * (phase_two_marks.c). */
+typedef struct p2_marks {
+    unsigned char *fine;    /* per pixel: a light's image in a mirror, metal
+                               or glass sphere may fall here, too small for
+                               the signatures: take the fine grid */
+    uint64_t *tips;         /* (pixel << 32 | light part), sorted: a vertex
+                               of the light part falls in the pixel */
+    size_t tip_count, tip_capacity;
+} p2_marks;
+/* Returns 0 when out of memory. */
+int p2_marks_build(p2_marks *m, const p2_ctx *c);
+void p2_marks_free(p2_marks *m);
+/* The light parts with a vertex in pixel (an index y * width + x): sets
+ * *tips to their entries (part = entry & 0xffffffff), returns how many. */
+int p2_marks_tips(const p2_marks *m, size_t pixel, const uint64_t **tips);
 
 /* Sample lists (phase_two_samples.c).  Returns 0 when out of memory. */
 int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays);

@@ -6,9 +6,10 @@
  * each surface (group of equal signatures), and each group is shaded on the
  * samples of a sparse 4 x 4 subset that fall in it (or on the cell nearest
  * its centroid when it misses the subset), weighted by its coverage.  Where
- * a light is seen in a mirror or through glass, the grid is 64 x 64.  Light
- * parts seen at a corner or a sample are listed for the exact level-0
- * coverage. */
+ * a light is seen in a mirror or through glass, or where phase_two_marks.c
+ * expects a light's small image in a sphere, the grid is 64 x 64.  Light
+ * parts seen at a corner or a sample, or with a vertex in the pixel, are
+ * listed for the exact level-0 coverage. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -91,6 +92,17 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
         float eta = leaving ? m->ior : 1.0f / m->ior;
         float sin2_t = eta * eta * (1.0f - cos_o * cos_o);
         if (m->weight[LOBE_REFRACTIVE] > 0.0f && sin2_t < 1.0f) {
+            /* The reflected branch is not followed, but a light seen along
+             * it (a light's image in the glass) has edges the grid must
+             * find: its part joins the signature. */
+            vec3f rd = f3_sub(d, f3_scale(n, 2.0f * f3_dot(d, n)));
+            hit hr = accel_intersect(rs, ray_offset(x, n), rd);
+            (*rays)++;
+            if (hr.part >= 0 && rs->parts[hr.part].is_light) {
+                sig = (sig ^ (uint32_t)(hr.part + 1) ^ 0x9e3779b9u) * 16777619u;
+                if (glint)
+                    *glint = 1;
+            }
             float cos_t = sqrtf(1.0f - sin2_t);
             d = f3_normalize(f3_sub(f3_scale(d, eta), f3_scale(n, cos_t - eta * cos_o)));
             o = ray_offset(x, f3_neg(n));
@@ -283,6 +295,8 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
     int g = c->g;
     uint32_t first = corners[0];
     int edge = corners[1] != first || corners[2] != first || corners[3] != first;
+    /* A light's image may fall here, too small for the signatures. */
+    int marked = c->marks && c->marks->fine[(size_t)py * c->c.width + px];
     size_t start = row->sample_count;
     int curved = 0;
     if (!grid_samples(c, px, py, g, first, lights, row, rays, &edge, &curved))
@@ -295,7 +309,7 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
         if (!grid_samples(c, px, py, CURVED_GRID, first, lights, row, rays, &edge, &curved))
             return 0;
     }
-    if (!edge)
+    if (!edge && !marked)
         return 1;
     row->sample_count = start;
 
@@ -305,7 +319,7 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
     if (!edge_samples(c, px, py, EDGE_GRID, EDGE_SHADE, *scratch, lights, row, rays, &glint,
                       &rim, 0))
         return 0;
-    if (glint || rim) {
+    if (glint || rim || marked) {
         /* A light seen in a mirror or through glass: its image is the
          * brightest thing around and often a few sub-pixels wide, so its
          * coverage is measured on a grid 16 times as fine, and shaded on
@@ -355,6 +369,12 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         note_light(rs, &lights, row->corner_part[x + 1]);
         note_light(rs, &lights, row->corner_part[w1 + x]);
         note_light(rs, &lights, row->corner_part[w1 + x + 1]);
+        if (c->marks) {
+            const uint64_t *tips;
+            int n = p2_marks_tips(c->marks, (size_t)y * w + x, &tips);
+            for (int k = 0; k < n; k++)
+                note_light(rs, &lights, (int)(tips[k] & 0xffffffffu));
+        }
         row->pixel_first[x] = row->sample_count;
         row->light_first[x] = row->light_count;
         if (!pixel_samples(c, x, y, cs, &lights, row, &scratch, rays) ||

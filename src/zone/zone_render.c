@@ -101,6 +101,10 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
     c.hi = o->level >= 0 ? o->level : o->depth;
     c.g = f->q.aa;
     zt_status st = p2_terms_build(&c.terms, f, r, c.lo, c.hi, err);
+    p2_marks marks = {NULL, NULL, 0, 0};
+    if (st == ZT_OK && !p2_marks_build(&marks, &c))
+        st = zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixel marks");
+    c.marks = &marks;
     uint64_t rays = 0;
     if (st == ZT_OK) {
         if (reference)
@@ -111,6 +115,7 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
             st = p2_render_pixels(&c, sum, &rays, err);
     }
     p2_terms_free(&c.terms);
+    p2_marks_free(&marks);
     if (stats) {
         stats->threads = render_thread_count(o->threads);
         /* Phase One's rays are charged to the first image, unless the

@@ -1,0 +1,149 @@
+/* What a pixel's own rays can miss, found from the eye
+ * (zone/phase_two_marks.c): a light smaller than a pixel, between its
+ * corner and sample rays, and a light's sub-pixel image in a mirror
+ * sphere.  Both against values computed here from the geometry alone. */
+#include "test_support.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "zonetrace/render.h"
+#include "zonetrace/scene.h"
+
+/* 8 x 8 pixels over the screen [-1, 1]^2 at z = 9, eye at z = 10: a pixel
+ * is 0.25 x 0.25 on the screen, and a point at z = 0 projects at 1/10 of
+ * its x and y. */
+#define CAMERA(n)                                                                           \
+    "\"camera\": {\"viewpoint\": [0, 0, 10], \"screen\": [[-1, 1, 9], [1, 1, 9], "       \
+    "[-1, -1, 9], [1, -1, 9]], \"gridresolution\": [" #n ", " #n "]}"
+
+static zt_image *zone_level(const char *text, int level)
+{
+    zt_scene *s = NULL;
+    zt_error err = {0};
+    assert_int_equal(zt_scene_load_string(text, strlen(text), "marks.json", &s, &err), ZT_OK);
+    zt_render_options o = zt_render_options_default();
+    o.method = ZT_METHOD_ZONE;
+    o.level = level;
+    o.depth = level;
+    o.threads = 2;
+    zt_image *img = NULL;
+    assert_int_equal(zt_render(s, &o, &img, NULL, &err), ZT_OK);
+    zt_scene_release(s);
+    return img;
+}
+
+/* Sum over the image of pixel value x pixel area on the screen: the
+ * integral of radiance over the screen. */
+static double screen_integral(const zt_image *img)
+{
+    double sum = 0;
+    for (int i = 0; i < img->width * img->height; i++)
+        sum += img->pixels[3 * i];
+    return sum * (2.0 / img->width) * (2.0 / img->height);
+}
+
+/* A light triangle whose projection, 1/10 of its size, lies inside pixel
+ * (3, 3) and meets none of its corners and not its centre: the pixel's rays
+ * all miss it.  Level 0 is its emission times its projected area. */
+static void test_light_between_rays(void **state)
+{
+    (void)state;
+    const char *text = "{\"scene\": [{\"lighttriangle\": {\"points\": [[-2.1, 0.4, 0], "
+                       "[-1.9, 0.4, 0], [-2.0, 0.6, 0]], \"emission\": [50, 50, 50]}}], " CAMERA(8) "}";
+    zt_image *img = zone_level(text, 0);
+    double area = 0.5 * 0.02 * 0.02; /* the projection on the screen */
+    double want = 50.0 * area, got = screen_integral(img);
+    printf("tiny light: screen integral %.6g, expected %.6g\n", got, want);
+    assert_true(fabs(got - want) < 1e-3 * want);
+    assert_true(zt_image_pixel(img, 3, 3)[0] > 0.0f);
+    zt_image_release(img);
+}
+
+static const double tri[3][3] = {{2.8, -0.2, 2.8}, {3.3, 0.0, 3.0}, {3.0, 0.3, 3.3}};
+
+/* Whether the ray (o, d) meets the light triangle. */
+static int hits_light(const double o[3], const double d[3])
+{
+    double e1[3], e2[3], p[3], s[3], q[3];
+    for (int i = 0; i < 3; i++) {
+        e1[i] = tri[1][i] - tri[0][i];
+        e2[i] = tri[2][i] - tri[0][i];
+        s[i] = o[i] - tri[0][i];
+    }
+    p[0] = d[1] * e2[2] - d[2] * e2[1];
+    p[1] = d[2] * e2[0] - d[0] * e2[2];
+    p[2] = d[0] * e2[1] - d[1] * e2[0];
+    double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    if (fabs(det) < 1e-14)
+        return 0;
+    double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
+    q[0] = s[1] * e1[2] - s[2] * e1[1];
+    q[1] = s[2] * e1[0] - s[0] * e1[2];
+    q[2] = s[0] * e1[1] - s[1] * e1[0];
+    double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+    double t = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
+    return u >= 0 && v >= 0 && u + v <= 1 && t > 0;
+}
+
+/* The screen area whose rays reflect off the unit sphere at the origin
+ * into the light: midpoint rule on an n x n grid over the square
+ * [-0.11, 0.11]^2 of the screen, which holds the sphere's outline (radius
+ * 1/sqrt(99) there). */
+static double image_area(int n)
+{
+    const double eye[3] = {0, 0, 10};
+    long count = 0;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            double d[3] = {0.11 * (-1 + 2 * (i + 0.5) / n), 0.11 * (1 - 2 * (j + 0.5) / n), -1};
+            double l = sqrt(d[0] * d[0] + d[1] * d[1] + 1);
+            for (int k = 0; k < 3; k++)
+                d[k] /= l;
+            double b = eye[0] * d[0] + eye[1] * d[1] + eye[2] * d[2];
+            double disc = b * b - (100 - 1);
+            if (disc <= 0)
+                continue;
+            double t = -b - sqrt(disc), p[3], r[3];
+            for (int k = 0; k < 3; k++)
+                p[k] = eye[k] + t * d[k];
+            double dp = d[0] * p[0] + d[1] * p[1] + d[2] * p[2];
+            for (int k = 0; k < 3; k++)
+                r[k] = d[k] - 2 * dp * p[k];
+            count += hits_light(p, r);
+        }
+    return count * (0.22 * 0.22 / ((double)n * n));
+}
+
+/* A small light beside a mirror sphere: its image is a fraction of a
+ * pixel.  Level 1 is the mirror's reflectance times the emission over the
+ * image's area. */
+static void test_image_in_sphere(void **state)
+{
+    (void)state;
+    const char *text =
+        "{\"scene\": [{\"lighttriangle\": {\"points\": [[2.8, -0.2, 2.8], [3.3, 0.0, 3.0], "
+        "[3.0, 0.3, 3.3]], \"emission\": [50, 50, 50]}},"
+        "{\"sphere\": {\"center\": [0, 0, 0], \"radius\": 1, \"material\": "
+        "{\"character\": {\"diffuse\": 0, \"metallic\": 0, \"reflecting\": 1, "
+        "\"refractive\": 0}, \"color\": [0.8, 0.8, 0.8]}}}], " CAMERA(64) "}";
+    zt_image *img = zone_level(text, 1);
+    double area = image_area(3000);
+    double want = 0.8 * 50.0 * area, got = screen_integral(img);
+    printf("image in sphere: %.3g of a pixel; screen integral %.6g, expected %.6g\n",
+           area / (0.03125 * 0.03125), got, want);
+    assert_true(area > 0 && area < 0.25 * 0.03125 * 0.03125);
+    /* The fine grid's 64 x 64 cells against the image's outline. */
+    assert_true(fabs(got - want) < 0.05 * want);
+    zt_image_release(img);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_light_between_rays),
+        cmocka_unit_test(test_image_in_sphere),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
