@@ -250,6 +250,7 @@ static void w_axis(wbuf *w, const map_axis *a)
     w_i32(w, a->n);
     w_i32(w, a->k0);
     w_i32(w, a->k1);
+    w_i32(w, a->grade);
     w_f64(w, a->w);
     w_f64(w, a->r);
     w_f64(w, a->len);
@@ -541,6 +542,7 @@ static map_axis r_axis(rbuf *rb)
     a.n = r_i32(rb);
     a.k0 = r_i32(rb);
     a.k1 = r_i32(rb);
+    a.grade = r_i32(rb);
     a.w = r_f64(rb);
     a.r = r_f64(rb);
     a.len = r_f64(rb);
@@ -550,7 +552,8 @@ static map_axis r_axis(rbuf *rb)
 
 static int axis_ok(const map_axis *a, int n)
 {
-    return a->n == n && a->k0 >= 0 && a->k0 < a->k1 && a->k1 <= a->n && a->w > 0 &&
+    return a->n == n && a->k0 >= 0 && a->k0 < a->k1 && a->k1 <= a->n && a->grade >= 0 &&
+           a->grade <= 16 && (a->grade == 0 || a->k1 - a->k0 >= 2 * a->grade + 2) && a->w > 0 &&
            a->r >= 1.0 && a->r < 16.0 && a->len > 0 && isfinite(a->w) && isfinite(a->len);
 }
 

@@ -327,7 +327,8 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
         if (o->is_light || o->mat.weight[LOBE_DIFFUSE] <= 0)
             continue;
         part_map *m = &f->maps[i];
-        map_layout_part(sc, &walls, i, lo, hi, f->q.texel, f->q.max_texels, &m->layout);
+        map_layout_part(sc, &walls, i, lo, hi, f->q.texel, f->q.max_texels, f->q.edge_grade,
+                        &m->layout);
         m->levels = f->map_levels + (f->sky_slot >= 0);
         size_t n = (size_t)m->levels * (size_t)m->layout.sides * (size_t)m->layout.nu *
                    (size_t)m->layout.nv * 3;

@@ -18,6 +18,7 @@ static int clampi(double v, int lo, int hi)
 #define OUTER_GROWTH 1.25
 #define OUTER_REACH 64.0
 
+
 /* Whether no light can reach the open half-space behind plane part q: q
  * is opaque and every light lies in front of it.  Culled or not makes no
  * difference here: light from the front stops at it either way, and an
@@ -87,13 +88,14 @@ static void room_clips(const zt_scene *sc, const map_walls *w, int p, vec3 pn, m
  * [c0, c1] (at most max of them) and growing ones outside it; *start is
  * where its first edge lies. */
 static map_axis axis_build(double d0, double d1, double c0, double c1, double texel,
-                           int max, double *start)
+                           int max, int grade, double *start)
 {
     map_axis a = {0};
     a.r = OUTER_GROWTH;
     int core = (int)ceil((c1 - c0) / texel);
     core = core < 1 ? 1 : core > max ? max : core;
     a.w = (c1 - c0) / core;
+    a.grade = core >= 2 ? grade : 0;
     /* Outer texels until the domain's end is covered. */
     double left = c0 - d0, right = d1 - c1;
     double k = (a.r - 1.0) / (a.w * a.r);
@@ -101,7 +103,7 @@ static map_axis axis_build(double d0, double d1, double c0, double c1, double te
     int mr = right > 1e-6 * a.w ? (int)ceil(log1p(right * k) / log(a.r) - 1e-9) : 0;
     double span_l = axis_outer_span(&a, ml), span_r = axis_outer_span(&a, mr);
     a.k0 = ml;
-    a.k1 = ml + core;
+    a.k1 = ml + core + 2 * a.grade;
     a.n = a.k1 + mr;
     a.len = span_l + core * a.w + span_r;
     *start = c0 - span_l;
@@ -109,7 +111,7 @@ static map_axis axis_build(double d0, double d1, double c0, double c1, double te
 }
 
 static void plane_layout(const zt_scene *sc, const map_walls *w, int index, vec3 lo, vec3 hi, double texel,
-                         int max_texels, map_layout *l)
+                         int max_texels, int grade, map_layout *l)
 {
     const part *p = &sc->parts[index];
     vec3 n = p->normal;
@@ -152,8 +154,8 @@ static void plane_layout(const zt_scene *sc, const map_walls *w, int index, vec3
     if (y1 - y0 < 1e-3 * texel)
         y0 = dy0, y1 = fmin(dy1, dy0 + texel * max_texels);
     double sx, sy;
-    l->au = axis_build(dx0, dx1, x0, x1, texel, max_texels, &sx);
-    l->av = axis_build(dy0, dy1, y0, y1, texel, max_texels, &sy);
+    l->au = axis_build(dx0, dx1, x0, x1, texel, max_texels, grade, &sx);
+    l->av = axis_build(dy0, dy1, y0, y1, texel, max_texels, grade, &sy);
     /* du x dv must point along the normal. */
     l->origin = v3_add(base, v3_add(v3_scale(u, sx), v3_scale(v, sy)));
     l->du = v3_scale(u, l->au.len);
@@ -163,7 +165,7 @@ static void plane_layout(const zt_scene *sc, const map_walls *w, int index, vec3
 }
 
 void map_layout_part(const zt_scene *sc, const map_walls *w, int i, vec3 lo, vec3 hi,
-                     double texel, int max_texels, map_layout *l)
+                     double texel, int max_texels, int grade, map_layout *l)
 {
     const part *p = &sc->parts[i];
     memset(l, 0, sizeof *l);
@@ -175,8 +177,10 @@ void map_layout_part(const zt_scene *sc, const map_walls *w, int i, vec3 lo, vec
         l->dv = v3_sub(p->p[2], p->p[0]);
         l->nu = clampi(v3_length(l->du) / texel, 2, max_texels);
         l->nv = clampi(v3_length(l->dv) / texel, 2, max_texels);
-        l->au = axis_uniform(l->nu, v3_length(l->du));
-        l->av = axis_uniform(l->nv, v3_length(l->dv));
+        l->au = axis_uniform(l->nu, v3_length(l->du), grade);
+        l->av = axis_uniform(l->nv, v3_length(l->dv), grade);
+        l->nu = l->au.n;
+        l->nv = l->av.n;
         /* The map covers the parallelogram around the triangle: keep
          * s + t <= 1, the side of the line p1 p2 where p0 lies. */
         vec3 nrm = v3_cross(l->du, l->dv);
@@ -192,10 +196,10 @@ void map_layout_part(const zt_scene *sc, const map_walls *w, int i, vec3 lo, vec
         l->radius = p->radius;
         l->nv = clampi(3.14159265358979 * p->radius / texel, 4, max_texels);
         l->nu = 2 * l->nv;
-        l->au = axis_uniform(l->nu, 1.0);
-        l->av = axis_uniform(l->nv, 1.0);
+        l->au = axis_uniform(l->nu, 1.0, 0);
+        l->av = axis_uniform(l->nv, 1.0, 0);
     } else {
-        plane_layout(sc, w, i, lo, hi, texel, max_texels, l);
+        plane_layout(sc, w, i, lo, hi, texel, max_texels, grade, l);
     }
 }
 

@@ -15,9 +15,12 @@ typedef struct map_walls {
 int map_layout_walls(const zt_scene *sc, int *walls);
 
 /* Lays part i out: texels of about `texel` (at most max_texels a side over
- * the scene's core [lo, hi]); for planes and triangles, the half-planes
- * that bound the surface that exists (clip_n, clip_d). */
+ * the scene's core [lo, hi]), the end ones of a plane's core and of a
+ * triangle's axes cut with `grade` (map_axis: where walls meet, at a
+ * room's corners and a triangle's edges, the indirect light can drop
+ * within the last texel); for planes and triangles, the half-planes that
+ * bound the surface that exists (clip_n, clip_d). */
 void map_layout_part(const zt_scene *sc, const map_walls *w, int i, vec3 lo, vec3 hi,
-                     double texel, int max_texels, map_layout *l);
+                     double texel, int max_texels, int grade, map_layout *l);
 
 #endif

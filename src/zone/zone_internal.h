@@ -43,6 +43,7 @@ typedef struct zone_quality {
     double theta;       /* transfer: pieces are split above this size/distance */
     int max_texels;     /* at most this many texels along a map's side */
     int glint_cuts;     /* a light triangle is cut n x n for its images */
+    int edge_grade;     /* maps' end texels cut this many times (map_axis) */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;

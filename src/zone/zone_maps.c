@@ -4,10 +4,23 @@
 
 #define ZT_PI_D 3.14159265358979323846
 
-map_axis axis_uniform(int n, double len)
+map_axis axis_uniform(int n, double len, int g)
 {
-    map_axis a = {n, 0, n, len / n, 1.0, len, NULL};
+    map_axis a = {n + 2 * g, 0, n + 2 * g, g, len / n, 1.0, len, NULL};
     return a;
+}
+
+/* Where edge j of a graded core lies, from its start. */
+static double core_edge(const map_axis *a, int j)
+{
+    int g = a->grade, m = a->k1 - a->k0;
+    if (j > m - g - 1) /* the far end mirrors the near one */
+        return axis_core_span(a) - core_edge(a, m - j);
+    if (j == 0)
+        return 0.0;
+    if (j <= g + 1)
+        return a->w * ldexp(1.0, j - 1 - g);
+    return a->w * (j - g);
 }
 
 double axis_outer_span(const map_axis *a, int m)
@@ -21,9 +34,9 @@ static double edge_formula(const map_axis *a, int i)
     if (i < a->k0)
         x = c0 - axis_outer_span(a, a->k0 - i);
     else if (i <= a->k1)
-        x = c0 + (i - a->k0) * a->w;
+        x = c0 + core_edge(a, i - a->k0);
     else
-        x = c0 + (a->k1 - a->k0) * a->w + axis_outer_span(a, i - a->k1);
+        x = c0 + axis_core_span(a) + axis_outer_span(a, i - a->k1);
     return x / a->len;
 }
 

@@ -10,11 +10,16 @@
 #include "util/vec3.h"
 
 /* Where the texel edges of one planar axis lie.  Texels [k0, k1) are the
- * core, of equal width w; outside it each texel is r times wider than its
- * inner neighbour, so a plane's map reaches far from the scene for a few
- * texels more.  Widths are in scene units; the axis is len long. */
+ * core, of width w, except that with grade g the core's first and last
+ * texels are cut into g + 1 each, halving towards the core's ends (w/2^g,
+ * w/2^g, w/2^(g-1), ..., w/2): where surfaces meet, at the core's and a
+ * triangle's edges, the light changes fastest.  Outside the core each
+ * texel is r times wider than its inner neighbour, so a plane's map reaches
+ * far from the scene for a few texels more.  Widths are in scene units;
+ * the axis is len long. */
 typedef struct map_axis {
     int n, k0, k1;
+    int grade;
     double w, r, len;
     double *edge;       /* the n + 1 edges as fractions of len (a cache of
                            the formula, made by map_layout_cache) */
@@ -80,8 +85,16 @@ int map_layout_cache(map_layout *l);
  * w r + w r^2 + ... + w r^m (0 for m = 0). */
 double axis_outer_span(const map_axis *a, int m);
 
-/* An axis with n equal texels. */
-map_axis axis_uniform(int n, double len);
+/* An axis with n equal texels, the end ones cut with grade g (n >= 2 when
+ * g > 0). */
+map_axis axis_uniform(int n, double len, int g);
+
+/* Width of the core's uncut texels times their count, plus the cut ones:
+ * the core's length in scene units. */
+static inline double axis_core_span(const map_axis *a)
+{
+    return (a->k1 - a->k0 - 2 * a->grade) * a->w;
+}
 
 /* The point at (s, t) of a planar layout. */
 vec3 map_point(const map_layout *l, double s, double t);
