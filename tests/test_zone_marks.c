@@ -1,11 +1,13 @@
 /* What a pixel's own rays can miss, found from the eye
  * (zone/phase_two_marks.c): a light smaller than a pixel, between its
  * corner and sample rays, and a light's sub-pixel image in a mirror
- * sphere.  Both against values computed here from the geometry alone. */
+ * sphere.  Both against values computed here from the geometry alone;
+ * and a pixel whose fine grid holds many surfaces. */
 #include "test_support.h"
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "zonetrace/render.h"
@@ -139,11 +141,47 @@ static void test_image_in_sphere(void **state)
     zt_image_release(img);
 }
 
+/* One pixel holding a mirror sphere, a light and a backdrop of 576 small
+ * triangles: its fine grid shades more samples than a pixel usually has
+ * (each small triangle is a group of its own), and the image must still
+ * be made, finite. */
+static void test_dense_fine_pixel(void **state)
+{
+    (void)state;
+    size_t cap = 1 << 17, len = 0;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    len += (size_t)snprintf(text + len, cap - len,
+                            "{\"scene\": [{\"lighttriangle\": {\"points\": [[-9, -9, -4], "
+                            "[-4, -9, -4], [-6.5, -4, -4]], \"emission\": [5, 5, 5]}},"
+                            "{\"sphere\": {\"center\": [0, 0, 0], \"radius\": 2, \"material\": "
+                            "{\"character\": {\"diffuse\": 0, \"metallic\": 0, \"reflecting\": 1, "
+                            "\"refractive\": 0}, \"color\": [0.8, 0.8, 0.8]}}}");
+    for (int j = 0; j < 24; j++)
+        for (int i = 0; i < 24; i++) {
+            double x = -12 + i, y = -12 + j;
+            len += (size_t)snprintf(text + len, cap - len,
+                                    ",{\"triangle\": {\"points\": [[%g, %g, -6], [%g, %g, -6], "
+                                    "[%g, %g, -6]], \"material\": {\"character\": {\"diffuse\": 1, "
+                                    "\"metallic\": 0, \"reflecting\": 0, \"refractive\": 0}, "
+                                    "\"color\": [0.5, 0.5, 0.5]}}}",
+                                    x, y, x + 0.9, y, x, y + 0.9);
+        }
+    snprintf(text + len, cap - len, "], " CAMERA(1) "}");
+    zt_image *img = zone_level(text, 1);
+    float *v = zt_image_pixel(img, 0, 0);
+    printf("dense pixel: %g %g %g\n", v[0], v[1], v[2]);
+    assert_true(isfinite(v[0]) && v[0] > 0.0f);
+    zt_image_release(img);
+    free(text);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_light_between_rays),
         cmocka_unit_test(test_image_in_sphere),
+        cmocka_unit_test(test_dense_fine_pixel),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

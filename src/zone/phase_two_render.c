@@ -40,7 +40,11 @@ static int pixel_terms(const p2_ctx *c, const p2_pixel *px, int **list, int *cap
     int parts = c->r->rs.part_count, n = 0;
     /* Distinct parts hit (parts stands for nothing hit), in first-seen
      * order; their term lists are disjoint. */
-    int seen[P2_MAX_PIXEL_SAMPLES], nseen = 0;
+    int seen_local[P2_MAX_PIXEL_SAMPLES], nseen = 0;
+    /* A fine grid over a dense mesh can shade more samples than that. */
+    int *seen = px->n <= P2_MAX_PIXEL_SAMPLES ? seen_local : malloc((size_t)px->n * sizeof *seen);
+    if (!seen)
+        return -1;
     for (int i = 0; i < px->n; i++) {
         int q = px->s[i].part < 0 ? parts : px->s[i].part, dup = 0;
         for (int j = 0; j < nseen && !dup; j++)
@@ -54,14 +58,19 @@ static int pixel_terms(const p2_ctx *c, const p2_pixel *px, int **list, int *cap
     if (need > *cap) {
         int nc = need + 64;
         int *nl = realloc(*list, (size_t)nc * sizeof *nl);
-        if (!nl)
+        if (!nl) {
+            if (seen != seen_local)
+                free(seen);
             return -1;
+        }
         *list = nl;
         *cap = nc;
     }
     for (int j = 0; j < nseen; j++)
         for (int k = T->part_first[seen[j]]; k < T->part_first[seen[j] + 1]; k++)
             (*list)[n++] = T->part_terms[k];
+    if (seen != seen_local)
+        free(seen);
     for (int i = 0; i < px->nlights; i++)
         if (T->root_term[px->lights[i]] >= 0)
             (*list)[n++] = T->root_term[px->lights[i]];
