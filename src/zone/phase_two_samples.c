@@ -2,9 +2,10 @@
  *
  * A pixel whose corner and sub-pixel signatures agree sees one smooth
  * surface: its g x g samples are shaded, each with weight 1/g^2.  Where they
- * differ, an edge crosses the pixel: a 16 x 16 grid measures the coverage of
- * each surface (group of equal signatures), and each group is shaded on the
- * samples of a sparse 4 x 4 subset that fall in it (or on the cell nearest
+ * differ, an edge crosses the pixel: a 16 x 16 grid (32 x 32 at quality 3,
+ * 64 x 64 from 4) measures the coverage of each surface (group of equal
+ * signatures), and each group is shaded on the samples of a sparse 4 x 4
+ * (8 x 8 from quality 4) subset that fall in it (or on the cell nearest
  * its centroid when it misses the subset), weighted by its coverage.  Where
  * a light is seen in a mirror or through glass, or where phase_two_marks.c
  * expects a light's small image in a sphere, the grid is 64 x 64.  Light
@@ -18,8 +19,6 @@
 #include "geom/shapes.h"
 #include "zone/phase_two.h"
 
-#define EDGE_GRID 16   /* sub-pixel grid for coverage at edges */
-#define EDGE_SHADE 4   /* shaded samples per side of that grid */
 #define FINE_GRID 64   /* the grid where a light is seen by way of a mirror */
 #define FINE_SHADE 16  /* and its shaded samples per side */
 #define SEEN_MAX 8     /* light parts listed per pixel */
@@ -316,7 +315,7 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
     if (!*scratch && !(*scratch = malloc(sizeof(edge_grid))))
         return 0;
     int glint = 0, rim = 0;
-    if (!edge_samples(c, px, py, EDGE_GRID, EDGE_SHADE, *scratch, lights, row, rays, &glint,
+    if (!edge_samples(c, px, py, c->f->q.edge_grid, c->f->q.edge_shade, *scratch, lights, row, rays, &glint,
                       &rim, 0))
         return 0;
     if (glint || rim || marked) {

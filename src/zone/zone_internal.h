@@ -44,6 +44,8 @@ typedef struct zone_quality {
     int max_texels;     /* at most this many texels along a map's side */
     int glint_cuts;     /* a light triangle is cut n x n for its images */
     int edge_grade;     /* maps' end texels cut this many times (map_axis) */
+    int edge_grid;      /* coverage grid of a pixel an edge crosses (<= 64) */
+    int edge_shade;     /* its shaded subset, per side (divides edge_grid) */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;
