@@ -349,10 +349,13 @@ static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, 
      * differently from the part behind: such pieces go down to texels, and
      * a texel the crossing cuts gives the light of its half in front. */
     if (n >= 3 && crossing_of(src->m, r->part) >= 0) {
-        int behind = 0;
-        for (int k = 0; k < n && !behind; k++)
-            behind = v3_dot(r->n, v3_sub(q[k], r->x)) < 0;
-        if (behind) {
+        int behind = 0, front = 0;
+        for (int k = 0; k < n; k++) {
+            double h = v3_dot(r->n, v3_sub(q[k], r->x));
+            behind |= h < 0;
+            front |= h > 0;
+        }
+        if (behind && front) {
             if (splittable)
                 return split(r, src, i0, j0, i1, j1);
             radiance = v3_mul(front_half(src->m, src->level, src->side, i0, j0, r), src->scale);
