@@ -243,6 +243,53 @@ static void test_levels_sum_to_depth(void **state)
     zt_scene_release(s);
 }
 
+/* Two triangles piercing each other (an X seen end on) under a point light
+ * and a sky: their maps are cut along the line where they cross.  The cut
+ * texels' other halves go into the forest file, and levels still add up. */
+static const char *cross_text =
+    "{\"scene\": [{\"sky\": {\"color\": [0.2, 0.1, 0.1]}},"
+    "{\"lightpoint\": {\"point\": [1, 6, 3], \"emission\": [20, 20, 20]}},"
+    "{\"triangle\": {\"points\": [[-4, -3, -4], [4, 3, -4], [0, 0, 4]], \"material\": "
+    DIFFUSE(0.8, 0.5, 0.3) "}},"
+    "{\"triangle\": {\"points\": [[-4, 3, -4], [4, -3, -4], [0, 0.5, 4]], \"material\": "
+    DIFFUSE(0.3, 0.6, 0.8) "}}"
+    "], \"camera\": {\"viewpoint\": [0.5, 0.3, 12], \"screen\": [[-1, 1, 11], "
+    "[1, 1, 11], [-1, -1, 11], [1, -1, 11]], \"gridresolution\": [20, 16]}}";
+
+static void test_crossings(void **state)
+{
+    (void)state;
+    zt_scene *s = scene_from(cross_text);
+    const int depth = 3;
+    zt_render_options o = zone_options(depth, 2);
+    zt_renderer *r = renderer(s, &o);
+    const char *path = test_tmp_path("cross.forest");
+    zt_error err = {0};
+    assert_int_equal(zt_renderer_save_forest(r, path, &err), ZT_OK);
+    zt_image *all = accumulate(r, s, NULL);
+    zt_render_options lo = o;
+    lo.forest_file = path;
+    zt_image *loaded = render(s, &lo, NULL);
+    assert_same_bytes(all, loaded, "crossings: built vs loaded forest");
+    zt_image_release(loaded);
+    zt_image *sum = zt_image_create(W, H);
+    for (int l = 0; l <= depth; l++) {
+        o.level = l;
+        zt_image *li = render(s, &o, NULL);
+        assert_true(image_mean(li) > 0);
+        for (size_t i = 0; i < floats(sum); i++)
+            sum->pixels[i] += li->pixels[i];
+        zt_image_release(li);
+    }
+    double e = rel_rmse(sum, all);
+    if (!(e < 1e-5))
+        fail_msg("crossings: levels 0..%d vs depth %d: rel_rmse %g", depth, depth, e);
+    zt_image_release(sum);
+    zt_image_release(all);
+    zt_renderer_release(r);
+    zt_scene_release(s);
+}
+
 static void test_lights_add_up(void **state)
 {
     (void)state;
@@ -509,6 +556,7 @@ int main(void)
         cmocka_unit_test(test_levels_sum_to_depth),
         cmocka_unit_test(test_lights_add_up),
         cmocka_unit_test(test_forest_round_trip),
+        cmocka_unit_test(test_crossings),
         cmocka_unit_test(test_forest_rejections),
         cmocka_unit_test(test_camera_moves_without_phase_one),
         cmocka_unit_test(test_cli),

@@ -333,6 +333,24 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
         w_i32(&w, m->levels);
         w_f32s(&w, m->texels, mip_values(m, 0));
         w_f32s(&w, m->weight[0], mip_weights(m, 0));
+        /* Crossings and the other halves of the texels they cut. */
+        w_i32(&w, m->crossings);
+        for (int c = 0; c < m->crossings; c++) {
+            w_v3(&w, m->cross[c].n);
+            w_f64(&w, m->cross[c].d);
+            w_v3(&w, m->cross[c].a);
+            w_v3(&w, m->cross[c].b);
+            w_i32(&w, m->cross[c].part);
+        }
+        if (m->crossings > 0) {
+            size_t cells = (size_t)l->nu * l->nv;
+            for (size_t k = 0; k < cells; k++) {
+                w_i32(&w, m->cut[k]);
+                w_i32(&w, m->alt_sign[k]);
+            }
+            w_f32s(&w, m->alt, mip_values(m, 0));
+            w_f32s(&w, m->alt_weight, mip_weights(m, 0));
+        }
     }
     /* File size and checksum. */
     uint64_t size = (uint64_t)w.n + 8;
@@ -610,6 +628,46 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
         if (rb->short_read)
             return ZT_ERR_PARSE;
+        m->crossings = r_i32(rb);
+        if (rb->short_read)
+            return ZT_ERR_PARSE;
+        if (m->crossings < 0 || m->crossings > MAP_CROSSINGS ||
+            (m->crossings > 0 && l->shape != SHAPE_TRIANGLE))
+            return corrupt(err, path, "bad crossing count");
+        if (m->crossings > 0) {
+            size_t cells = (size_t)l->nu * l->nv;
+            m->cross = malloc((size_t)m->crossings * sizeof *m->cross);
+            m->cut = malloc(cells);
+            m->alt_sign = malloc(cells);
+            if (!m->cross || !m->cut || !m->alt_sign)
+                return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+            for (int c = 0; c < m->crossings; c++) {
+                m->cross[c].n = r_v3(rb);
+                m->cross[c].d = r_f64(rb);
+                m->cross[c].a = r_v3(rb);
+                m->cross[c].b = r_v3(rb);
+                m->cross[c].part = r_i32(rb);
+                if (m->cross[c].part < 0 || m->cross[c].part >= parts)
+                    return corrupt(err, path, "bad crossing");
+            }
+            for (size_t k = 0; k < cells; k++) {
+                int cut = r_i32(rb), sign = r_i32(rb);
+                if (rb->short_read)
+                    return ZT_ERR_PARSE;
+                if (cut < -1 || cut >= m->crossings || (cut >= 0 && sign != 1 && sign != -1) ||
+                    (cut < 0 && sign != 0))
+                    return corrupt(err, path, "bad cut texel");
+                m->cut[k] = (signed char)cut;
+                m->alt_sign[k] = (signed char)sign;
+            }
+            m->alt = r_f32s(rb, mip_values(m, 0), &oom);
+            if (m->alt)
+                m->alt_weight = r_f32s(rb, mip_weights(m, 0), &oom);
+            if (oom)
+                return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+            if (rb->short_read)
+                return ZT_ERR_PARSE;
+        }
         for (int level = 0; level < m->levels; level++)
             if (!derive_level(m, level))
                 return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
@@ -826,6 +884,10 @@ void forest_memory(const zone_forest *f, uint64_t *zones, uint64_t *occluders, u
             continue;
         for (int k = 0; k < m->mips; k++)
             mb += (mip_values(m, k) + mip_weights(m, k)) * sizeof(float);
+        if (m->crossings > 0)
+            mb += (mip_values(m, 0) + mip_weights(m, 0)) * sizeof(float) +
+                  (size_t)m->layout.nu * m->layout.nv * 2 +
+                  (size_t)m->crossings * sizeof *m->cross;
     }
     *maps = mb;
 }

@@ -256,6 +256,17 @@ static void texel_eval_point(const part_map *m, int u, int j, int side, vec3 *x,
         *n = v3_scale(*n, -1);
 }
 
+/* Where the other half of a cut texel is lit. */
+static void texel_alt_point(const part_map *m, int u, int j, int side, vec3 *x, vec3 *n)
+{
+    const map_layout *l = &m->layout;
+    map_texel_point(l, u, j, x, n);
+    const float *st = m->alt_st + 2 * ((size_t)j * l->nu + u);
+    *x = map_point(l, st[0], st[1]);
+    if (side)
+        *n = v3_scale(*n, -1);
+}
+
 /* A texel whose centre is unreachable (under an object standing on the
  * surface) may still be partly lit: it then takes its value at the
  * reachable one of a 4 x 4 set of points inside it nearest their centroid.
@@ -338,6 +349,22 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
             free(walls.part);
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
         }
+        /* Where other triangles pierce it, its texels are cut in two. */
+        map_crossing cross[MAP_CROSSINGS];
+        int nc = map_layout_crossings(sc, i, cross, MAP_CROSSINGS);
+        if (nc > 0) {
+            m->cross = malloc((size_t)nc * sizeof *m->cross);
+            if (!m->cross) {
+                free(walls.part);
+                return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
+            }
+            memcpy(m->cross, cross, (size_t)nc * sizeof *m->cross);
+            m->crossings = nc;
+            if (!map_build_cuts(m)) {
+                free(walls.part);
+                return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
+            }
+        }
     }
     free(walls.part);
     f->blockers = transfer_blockers_build(sc);
@@ -380,6 +407,19 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                     texel_rescue(&r->rs, m, i, u, j, side, dirs, f->q.gather))
                     w = 1.0f;
                 m->weight[0][((size_t)side * m->layout.nv + j) * m->layout.nu + u] = w;
+                size_t k = (size_t)j * m->layout.nu + u;
+                if (m->crossings && m->cut[k] >= 0) {
+                    /* The other half of a cut texel: reachable at its own
+                     * point, on its own side of the crossing (a rescued
+                     * point may have moved over: then the texel is whole). */
+                    vec3 xa, na;
+                    texel_alt_point(m, u, j, side, &xa, &na);
+                    texel_eval_point(m, u, j, side, &x, &n);
+                    const map_crossing *c = &m->cross[m->cut[k]];
+                    int main_sign = v3_dot(c->n, x) - c->d > 0 ? 1 : -1;
+                    m->alt_weight[(size_t)side * m->layout.nv * m->layout.nu + k] =
+                        main_sign == m->alt_sign[k] ? 0.0f : texel_weight(&r->rs, i, xa, na, dirs, f->q.gather);
+                }
             }
         }
     }
@@ -411,6 +451,21 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                     px[0] = (float)e.x;
                     px[1] = (float)e.y;
                     px[2] = (float)e.z;
+                    size_t k = (size_t)j * m->layout.nu + u;
+                    if (m->crossings && m->cut[k] >= 0) {
+                        size_t ka = (size_t)side * m->layout.nv * m->layout.nu + k;
+                        vec3 ea = v3(0, 0, 0);
+                        if (m->alt_weight[ka] > 0) {
+                            texel_alt_point(m, u, j, side, &x, &n);
+                            ea = level == f->sky_slot ? sky_texel(&t, f, x, n, dirs)
+                                                      : texel_value(&t, f, i, level, x, n, dirs,
+                                                                    f->q.theta * texel_growth(m, u, j));
+                        }
+                        float *pa = m->alt + (((size_t)level * m->layout.sides) * m->layout.nv * m->layout.nu + ka) * 3;
+                        pa[0] = (float)ea.x;
+                        pa[1] = (float)ea.y;
+                        pa[2] = (float)ea.z;
+                    }
                 }
                 rays += t.rays;
             }

@@ -203,3 +203,73 @@ void map_layout_part(const zt_scene *sc, const map_walls *w, int i, vec3 lo, vec
     }
 }
 
+
+/* The chord of triangle t where it crosses the plane n . p = d, as its two
+ * ends; 0 when t does not strictly cross the plane. */
+static int chord(const vec3 *t, vec3 n, double d, double eps, vec3 *a, vec3 *b)
+{
+    double s[3];
+    int pos = 0, neg = 0;
+    for (int k = 0; k < 3; k++) {
+        s[k] = v3_dot(n, t[k]) - d;
+        pos += s[k] > eps;
+        neg += s[k] < -eps;
+    }
+    if (!pos || !neg)
+        return 0;
+    vec3 e[2];
+    int m = 0;
+    for (int k = 0; k < 3 && m < 2; k++) {
+        int k1 = (k + 1) % 3;
+        if ((s[k] > 0) != (s[k1] > 0))
+            e[m++] = v3_add(t[k], v3_scale(v3_sub(t[k1], t[k]), s[k] / (s[k] - s[k1])));
+    }
+    if (m < 2)
+        return 0;
+    *a = e[0];
+    *b = e[1];
+    return 1;
+}
+
+int map_layout_crossings(const zt_scene *sc, int i, map_crossing *out, int max)
+{
+    const part *pi = &sc->parts[i];
+    if (pi->shape != SHAPE_TRIANGLE)
+        return 0;
+    vec3 ni = v3_normalize(v3_cross(v3_sub(pi->p[1], pi->p[0]), v3_sub(pi->p[2], pi->p[0])));
+    double di = v3_dot(ni, pi->p[0]);
+    int count = 0;
+    for (int j = 0; j < sc->part_count && count < max; j++) {
+        const part *pj = &sc->parts[j];
+        if (j == i || pj->shape != SHAPE_TRIANGLE)
+            continue;
+        vec3 nj = v3_normalize(v3_cross(v3_sub(pj->p[1], pj->p[0]), v3_sub(pj->p[2], pj->p[0])));
+        double dj = v3_dot(nj, pj->p[0]);
+        double size = 0;
+        for (int k = 0; k < 3; k++)
+            size = fmax(size, fmax(v3_length(v3_sub(pi->p[k], pi->p[(k + 1) % 3])),
+                                   v3_length(v3_sub(pj->p[k], pj->p[(k + 1) % 3]))));
+        double eps = 1e-7 * size;
+        vec3 a, b, c, e;
+        /* Each must cross the other's plane (touching is not piercing: a
+         * block standing on a floor does not cut it). */
+        if (!chord(pi->p, nj, dj, eps, &a, &b) || !chord(pj->p, ni, di, eps, &c, &e))
+            continue;
+        /* Both chords lie on the planes' common line: keep their overlap. */
+        vec3 dir = v3_sub(b, a);
+        double len2 = v3_dot(dir, dir);
+        if (len2 <= eps * eps)
+            continue;
+        double tc = v3_dot(v3_sub(c, a), dir) / len2, te = v3_dot(v3_sub(e, a), dir) / len2;
+        double t0 = fmax(0.0, fmin(tc, te)), t1 = fmin(1.0, fmax(tc, te));
+        if (t1 - t0 <= 1e-9)
+            continue;
+        map_crossing *x = &out[count++];
+        x->n = nj;
+        x->d = dj;
+        x->a = v3_add(a, v3_scale(dir, t0));
+        x->b = v3_add(a, v3_scale(dir, t1));
+        x->part = j;
+    }
+    return count;
+}

@@ -23,4 +23,9 @@ int map_layout_walls(const zt_scene *sc, int *walls);
 void map_layout_part(const zt_scene *sc, const map_walls *w, int i, vec3 lo, vec3 hi,
                      double texel, int max_texels, int grade, map_layout *l);
 
+/* The lines where other triangles pierce triangle part i (each strictly
+ * crosses the other's plane and their chords overlap), at most max of
+ * them, into out; returns their count (0 for other shapes). */
+int map_layout_crossings(const zt_scene *sc, int i, map_crossing *out, int max);
+
 #endif

@@ -43,6 +43,17 @@ int transfer_build_tables(part_map *m, int level)
                               m->cover[(size_t)j * l->nu + i];
                 double ww = area * wt[(size_t)j * l->nu + i];
                 double cell[4] = {ww * v[0], ww * v[1], ww * v[2], area};
+                size_t k = (size_t)j * l->nu + i;
+                if (m->crossings && m->cut[k] >= 0) {
+                    /* A cut texel: both halves, by their areas. */
+                    size_t ka = (size_t)side * l->nv * l->nu + k;
+                    const float *va = m->alt + ((size_t)level * l->sides * l->nv * l->nu + ka) * 3;
+                    double ac = m->alt_cover[k];
+                    double wa = area * ac * m->alt_weight[ka];
+                    ww *= 1.0 - ac;
+                    for (int c = 0; c < 3; c++)
+                        cell[c] = ww * v[c] + wa * va[c];
+                }
                 double *o = s + ((size_t)(j + 1) * w + (i + 1)) * 4;
                 const double *up = s + ((size_t)j * w + (i + 1)) * 4;
                 const double *left = s + ((size_t)(j + 1) * w + i) * 4;
@@ -267,6 +278,33 @@ static int seen(const receiver *r, const source *src, const vec3 *q, int n)
 
 static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, int j1);
 
+/* Which crossing of map m is part q's (-1: none). */
+static int crossing_of(const part_map *m, int q)
+{
+    for (int k = 0; k < m->crossings; k++)
+        if (m->cross[k].part == q)
+            return k;
+    return -1;
+}
+
+/* The irradiance of texel (i, j) on the receiver's side of its own
+ * surface, where that surface pierces the source: the texel's half in front
+ * of the receiver when the crossing cuts it, else the texel. */
+static vec3 front_half(const part_map *m, int level, int side, int i, int j, const receiver *r)
+{
+    const map_layout *l = &m->layout;
+    size_t k = (size_t)j * l->nu + i, ka = (size_t)side * l->nv * l->nu + k;
+    const float *v = map_texel(m, level, side, i, j);
+    double w = m->weight[0][ka];
+    int c = m->cut[k];
+    if (c >= 0 && m->cross[c].part == r->part &&
+        (v3_dot(m->cross[c].n, r->n) > 0 ? 1 : -1) == m->alt_sign[k]) {
+        v = m->alt + ((size_t)level * l->sides * l->nv * l->nu + ka) * 3;
+        w = m->alt_weight[ka];
+    }
+    return w > 0 ? v3(v[0], v[1], v[2]) : v3(0, 0, 0);
+}
+
 /* The piece in two halves, across its longer side. */
 static vec3 split(const receiver *r, const source *src, int i0, int j0, int i1, int j1)
 {
@@ -306,7 +344,23 @@ static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, 
     /* Only the surface that exists (a triangle, a plane inside its room)... */
     for (int k = 0; k < l->clips && n >= 3; k++)
         n = poly3_clip(q, n, PIECE_MAX, l->clip_n[k], l->clip_d[k]);
-    /* ...above the receiver's horizon. */
+    /* ...above the receiver's horizon.  Where the receiver's surface
+     * pierces the source, the part of the source in front of it is lit
+     * differently from the part behind: such pieces go down to texels, and
+     * a texel the crossing cuts gives the light of its half in front. */
+    if (n >= 3 && crossing_of(src->m, r->part) >= 0) {
+        int behind = 0, front = 0;
+        for (int k = 0; k < n; k++) {
+            double h = v3_dot(r->n, v3_sub(q[k], r->x));
+            behind |= h < 0;
+            front |= h > 0;
+        }
+        if (behind && front) {
+            if (splittable)
+                return split(r, src, i0, j0, i1, j1);
+            radiance = v3_mul(front_half(src->m, src->level, src->side, i0, j0, r), src->scale);
+        }
+    }
     if (n >= 3)
         n = poly3_clip(q, n, PIECE_MAX, r->n, -v3_dot(r->n, r->x));
     if (n < 3)

@@ -224,6 +224,113 @@ int map_build_cover(part_map *m)
     return 1;
 }
 
+static double crossing_side(const map_crossing *c, vec3 p)
+{
+    return v3_dot(c->n, p) - c->d;
+}
+
+int map_separated(const part_map *m, vec3 x, vec3 y, int skip)
+{
+    for (int k = 0; k < m->crossings; k++) {
+        const map_crossing *c = &m->cross[k];
+        double sx = crossing_side(c, x), sy = crossing_side(c, y);
+        if (k == skip || (sx > 0) == (sy > 0))
+            continue;
+        vec3 z = v3_add(x, v3_scale(v3_sub(y, x), sx / (sx - sy)));
+        vec3 ab = v3_sub(c->b, c->a);
+        double t = v3_dot(v3_sub(z, c->a), ab) / v3_dot(ab, ab);
+        if (t >= 0.0 && t <= 1.0)
+            return 1;
+    }
+    return 0;
+}
+
+/* Whether crossing c's segment passes through convex polygon q (n
+ * corners, on the surface of normal nrm, centroid cen). */
+static int segment_meets(const map_crossing *c, const vec3 *q, int n, vec3 nrm, vec3 cen)
+{
+    double t0 = 0.0, t1 = 1.0;
+    vec3 ab = v3_sub(c->b, c->a);
+    for (int k = 0; k < n && t0 < t1; k++) {
+        vec3 en = v3_cross(nrm, v3_sub(q[(k + 1) % n], q[k]));
+        if (v3_dot(en, v3_sub(cen, q[k])) < 0)
+            en = v3_scale(en, -1);
+        /* en . (a + t ab - q[k]) >= 0 */
+        double al = v3_dot(en, v3_sub(c->a, q[k])), be = v3_dot(en, ab);
+        if (fabs(be) < 1e-300) {
+            if (al < 0)
+                return 0;
+        } else if (be > 0) {
+            t0 = fmax(t0, -al / be);
+        } else {
+            t1 = fmin(t1, -al / be);
+        }
+    }
+    return t1 - t0 > 1e-9;
+}
+
+int map_build_cuts(part_map *m)
+{
+    const map_layout *l = &m->layout;
+    size_t cells = (size_t)l->nu * l->nv;
+    m->cut = malloc(cells);
+    m->alt_sign = malloc(cells);
+    m->alt_cover = calloc(cells, sizeof(float));
+    m->alt_st = calloc(cells * 2, sizeof(float));
+    m->alt = calloc((size_t)m->levels * l->sides * cells * 3, sizeof(float));
+    m->alt_weight = calloc((size_t)l->sides * cells, sizeof(float));
+    if (!m->cut || !m->alt_sign || !m->alt_cover || !m->alt_st || !m->alt || !m->alt_weight)
+        return 0;
+    vec3 nrm = v3_normalize(v3_cross(l->du, l->dv));
+    enum { QMAX = 2 * MAP_CLIPS + 8 };
+    for (int j = 0; j < l->nv; j++)
+        for (int i = 0; i < l->nu; i++) {
+            size_t k = (size_t)j * l->nu + i;
+            m->cut[k] = -1;
+            m->alt_sign[k] = 0;
+            if (m->cover[k] <= 0)
+                continue;
+            vec3 q[QMAX], cen;
+            int n = map_texel_polygon(l, i, j, q, QMAX);
+            if (n < 3)
+                continue;
+            double whole = poly3_area(q, n, &cen), best = 1e-4 * whole;
+            for (int c = 0; c < m->crossings; c++) {
+                const map_crossing *x = &m->cross[c];
+                if (!segment_meets(x, q, n, nrm, cen))
+                    continue;
+                vec3 hp[QMAX], hn[QMAX], cp, cn;
+                for (int a = 0; a < n; a++)
+                    hp[a] = hn[a] = q[a];
+                int np = poly3_clip(hp, n, QMAX, x->n, -x->d);
+                int nn = poly3_clip(hn, n, QMAX, v3_scale(x->n, -1), x->d);
+                double ap = np >= 3 ? poly3_area(hp, np, &cp) : 0.0;
+                double an = nn >= 3 ? poly3_area(hn, nn, &cn) : 0.0;
+                double small = fmin(ap, an);
+                if (small <= best)
+                    continue;
+                /* The larger half keeps the texel's value; the smaller
+                 * one gets its own. */
+                best = small;
+                int alt_pos = ap < an;
+                vec3 big = alt_pos ? cn : cp, other = alt_pos ? cp : cn;
+                m->cut[k] = (signed char)c;
+                m->alt_sign[k] = alt_pos ? 1 : -1;
+                m->alt_cover[k] = (float)(small / (ap + an));
+                double s, t;
+                plane_st(l, other, &s, &t);
+                m->alt_st[2 * k] = (float)s;
+                m->alt_st[2 * k + 1] = (float)t;
+                plane_st(l, big, &s, &t);
+                for (int side = 0; side < l->sides; side++) {
+                    m->eval_st[2 * (side * cells + k)] = (float)s;
+                    m->eval_st[2 * (side * cells + k) + 1] = (float)t;
+                }
+            }
+        }
+    return 1;
+}
+
 static int mip_size(int n, int k)
 {
     n >>= k;
@@ -265,13 +372,21 @@ static void axis_pick(double u, int n, int wrap, int extend, int *i0, int *i1, d
     *f = u - a;
 }
 
-/* Bilinear read of one level and side of mip k at normalised (s, t). */
-static vec3 bilinear(const part_map *m, int k, int level, int side, double s, double t)
+/* Bilinear read of one level and side of mip k at normalised (s, t).  On
+ * the finest grid of a map with crossings, x (the point read) decides
+ * which half of a cut texel is read, and texels a crossing separates from
+ * x do not take part: the light jumps there and must not be smeared. */
+static vec3 bilinear(const part_map *m, int k, int level, int side, double s, double t,
+                     const vec3 *x)
 {
     const map_layout *l = &m->layout;
     int nu = mip_size(l->nu, k), nv = mip_size(l->nv, k);
-    const float *base = m->mip[k] + (((size_t)level * l->sides + side) * (size_t)nv * nu) * 3;
+    size_t plane = ((size_t)level * l->sides + side) * (size_t)nv * nu;
+    const float *base = m->mip[k] + plane * 3;
     const float *wt = m->weight[k] + (size_t)side * nv * nu;
+    int cross = k == 0 && x && m->crossings > 0;
+    const float *alt = cross ? m->alt + plane * 3 : NULL;
+    const float *awt = cross ? m->alt_weight + (size_t)side * nv * nu : NULL;
     double u = s * nu - 0.5, v = t * nv - 0.5;
     int wrap = l->shape == SHAPE_SPHERE;
     for (int extend = 1; extend >= 0; extend--) {
@@ -282,8 +397,25 @@ static vec3 bilinear(const part_map *m, int k, int level, int side, double s, do
         size_t idx[4] = {(size_t)j0 * nu + i0, (size_t)j0 * nu + i1, (size_t)j1 * nu + i0,
                          (size_t)j1 * nu + i1};
         double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
+        const float *val[4];
+        double tw[4];
+        for (int q = 0; q < 4; q++) {
+            val[q] = base + idx[q] * 3;
+            tw[q] = wt[idx[q]];
+            if (!cross)
+                continue;
+            int c = m->cut[idx[q]];
+            if (c >= 0 && (crossing_side(&m->cross[c], *x) > 0 ? 1 : -1) == m->alt_sign[idx[q]]) {
+                val[q] = alt + idx[q] * 3;
+                tw[q] = awt[idx[q]];
+            }
+            vec3 centre, nn;
+            map_texel_point(l, (int)(idx[q] % nu), (int)(idx[q] / nu), &centre, &nn);
+            if (tw[q] > 0 && map_separated(m, *x, centre, c))
+                tw[q] = 0;
+        }
         int outside = fu < 0 || fu > 1 || fv < 0 || fv > 1;
-        if (outside && (wt[idx[0]] <= 0 || wt[idx[1]] <= 0 || wt[idx[2]] <= 0 || wt[idx[3]] <= 0))
+        if (outside && (tw[0] <= 0 || tw[1] <= 0 || tw[2] <= 0 || tw[3] <= 0))
             continue; /* extrapolate only from four reachable texels */
         /* Texels off the reachable surface do not take part; the values
          * are weighted means, so they are scaled back by their weights. */
@@ -291,12 +423,25 @@ static vec3 bilinear(const part_map *m, int k, int level, int side, double s, do
         vec3 r = v3(0, 0, 0);
         vec3 plain = v3(0, 0, 0);
         for (int q = 0; q < 4; q++) {
-            double ww = w[q] * wt[idx[q]];
-            const float *px = base + idx[q] * 3;
-            vec3 val = v3(px[0], px[1], px[2]);
-            r = v3_add(r, v3_scale(val, ww));
-            plain = v3_add(plain, v3_scale(val, w[q]));
+            double ww = w[q] * tw[q];
+            vec3 vq = v3(val[q][0], val[q][1], val[q][2]);
+            r = v3_add(r, v3_scale(vq, ww));
+            plain = v3_add(plain, v3_scale(vq, w[q]));
             sw += ww;
+        }
+        if (sw <= 1e-6 && cross) {
+            /* Every neighbour lies across a crossing: the texel under x,
+             * its half on x's side. */
+            int ic = (int)floor(s * nu), jc = (int)floor(t * nv);
+            ic = ic < 0 ? 0 : ic >= nu ? nu - 1 : ic;
+            jc = jc < 0 ? 0 : jc >= nv ? nv - 1 : jc;
+            size_t kc = (size_t)jc * nu + ic;
+            int c = m->cut[kc];
+            const float *pv = base + kc * 3;
+            if (c >= 0 && (crossing_side(&m->cross[c], *x) > 0 ? 1 : -1) == m->alt_sign[kc] &&
+                awt[kc] > 0)
+                pv = alt + kc * 3;
+            return v3(pv[0], pv[1], pv[2]);
         }
         /* Nothing reachable around: the plain bilinear value.  (Not
          * clamped at zero where extrapolated: light must add up linearly,
@@ -323,10 +468,10 @@ vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double widt
     if (lod > m->mips - 1)
         lod = m->mips - 1;
     int k0 = (int)lod;
-    vec3 a = bilinear(m, k0, level, side, s, t);
+    vec3 a = bilinear(m, k0, level, side, s, t, &p);
     if (k0 + 1 >= m->mips || lod == k0)
         return a;
-    vec3 b = bilinear(m, k0 + 1, level, side, s, t);
+    vec3 b = bilinear(m, k0 + 1, level, side, s, t, &p);
     double f = lod - k0;
     return v3_add(v3_scale(a, 1 - f), v3_scale(b, f));
 }
@@ -388,9 +533,13 @@ void map_free_phase_one(part_map *m)
     free(m->sat);
     free(m->cover);
     free(m->eval_st);
+    free(m->alt_cover);
+    free(m->alt_st);
     m->sat = NULL;
     m->cover = NULL;
     m->eval_st = NULL;
+    m->alt_cover = NULL;
+    m->alt_st = NULL;
 }
 
 void map_free(part_map *m)
@@ -405,4 +554,11 @@ void map_free(part_map *m)
     free(m->sat);
     free(m->cover);
     free(m->eval_st);
+    free(m->cross);
+    free(m->cut);
+    free(m->alt_sign);
+    free(m->alt);
+    free(m->alt_weight);
+    free(m->alt_cover);
+    free(m->alt_st);
 }

@@ -48,6 +48,19 @@ typedef struct map_layout {
 
 #define MAP_MIPS 8
 
+/* At most this many lines where other surfaces pierce a planar part. */
+#define MAP_CROSSINGS 64
+
+/* A line where another triangle pierces a planar part: the other's plane
+ * (n . p = d) and the segment of the line that lies on both, a to b.  The
+ * light on the part jumps across it (one side may be hidden from a light,
+ * or see other surfaces), so a map must not smear it. */
+typedef struct map_crossing {
+    vec3 n, a, b;
+    double d;
+    int part;           /* the piercing part */
+} map_crossing;
+
 /* The grid of one part: texel values for each level and side, and coarser
  * copies (each halving the resolution) for lookups that stand for a wide
  * cone of directions. */
@@ -67,6 +80,20 @@ typedef struct part_map {
      * One only. */
     float *cover;
     float *eval_st;
+    /* Crossings: texels a crossing cuts are split in two along it.  cut[k]
+     * is the crossing cutting texel k (-1: none); the texel's value is that
+     * of its larger half, alt[] holds the other half's, on the side of the
+     * crossing's plane given by alt_sign[k] (+1: n . p > d).  alt_weight
+     * is the other half's reachability, per side and texel, as weight[0];
+     * alt_cover its share of the texel's area (Phase One only), alt_st the
+     * point where it is computed (Phase One only). */
+    int crossings;
+    map_crossing *cross;
+    signed char *cut, *alt_sign;
+    float *alt;         /* [level][side][v][u][rgb], only with crossings */
+    float *alt_weight;
+    float *alt_cover;
+    float *alt_st;
     /* Summed-area tables per level and side: [level][side][(nv+1)*(nu+1)]
      * of area*weight*rgb (3 doubles) and area, built by transfer.c. */
     double *sat;
@@ -112,6 +139,16 @@ int map_build_cover(part_map *m);
 
 /* Where point p (on the part) falls on the grid, in texel units. */
 void map_coords(const map_layout *l, vec3 p, double *u, double *v);
+
+/* Finds the texels the map's crossings cut (m->cross must be set) and
+ * splits them: cut, alt_sign, alt_cover, alt_st, and the larger halves'
+ * points in eval_st (after map_build_cover); allocates alt and
+ * alt_weight.  Returns 0 when out of memory. */
+int map_build_cuts(part_map *m);
+
+/* Whether a crossing of the map separates points x and y of its surface:
+ * the segment x y passes through a crossing's segment (other than `skip`). */
+int map_separated(const part_map *m, vec3 x, vec3 y, int skip);
 
 /* Builds the coarser copies of one level (after its texels are final).
  * The first call also builds the coarser weights from weight[0]. */
