@@ -298,6 +298,19 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
     int marked = c->marks && c->marks->fine[(size_t)py * c->c.width + px];
     size_t start = row->sample_count;
     int curved = 0;
+    int probe = c->f->q.probe;
+    if (!edge && !marked && probe > g) {
+        /* More signatures than samples: a thin surface or a sliver of
+         * light between shadows can pass between the g x g samples. */
+        const rscene *rs = &c->r->rs;
+        for (int k = 0; k < probe * probe && !edge; k++) {
+            vec3f org, dir;
+            hit h;
+            cam_ray(&c->c, (float)px + (k % probe + 0.5f) / probe,
+                    (float)py + (k / probe + 0.5f) / probe, &org, &dir);
+            edge = ray_signature(rs, org, dir, rays, &h, NULL, NULL) != first;
+        }
+    }
     if (!grid_samples(c, px, py, g, first, lights, row, rays, &edge, &curved))
         return 0;
     if (!edge && curved && g < CURVED_GRID) {

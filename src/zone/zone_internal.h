@@ -46,6 +46,8 @@ typedef struct zone_quality {
     int edge_grade;     /* maps' end texels cut this many times (map_axis) */
     int edge_grid;      /* coverage grid of a pixel an edge crosses (<= 64) */
     int edge_shade;     /* its shaded subset, per side (divides edge_grid) */
+    int probe;          /* signatures per side that look for an edge in a
+                           pixel (no more than aa: the samples' own) */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;
