@@ -43,6 +43,7 @@ typedef struct zone_quality {
     double theta;       /* transfer: pieces are split above this size/distance */
     int max_texels;     /* at most this many texels along a map's side */
     int glint_cuts;     /* a light triangle is cut n x n for its images */
+    int photons;        /* caustic photons per light (caustic.h) */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;
@@ -105,8 +106,12 @@ enum {
                             camera's level 0 is measured analytically) */
     ZR_SKIP_FLAT_DIFFUSE = 4, /* the diffuse lobe of a flat part hit by this
                             very ray counts nothing (transfer covers it) */
-    ZR_NO_GLINT = 8      /* a light seen in a glint sphere (glint.h) by this
+    ZR_NO_GLINT = 8,     /* a light seen in a glint sphere (glint.h) by this
                             very ray counts nothing (its image covers it) */
+    ZR_NO_CAUSTIC = 16   /* a light reached after one or more specular events
+                            and no diffuse one, the last of them off a
+                            caustic target (caustic.h), counts nothing: the
+                            photons carry it */
 };
 vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count);
