@@ -7,7 +7,6 @@
 
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "render/render_internal.h"
@@ -133,40 +132,41 @@ static zt_scene *load(void)
     return s;
 }
 
-/* The floor's level-2 map matches the integral where the caustic is
- * smooth on the texels' scale, and comes closer as the quality rises.
- * CAUSTIC_PROFILE=1 prints a profile through the cusp. */
+/* The floor's level-2 map along a line through the caustic's cusp (under
+ * the ball's centre) matches the integral, and comes closer there as the
+ * quality rises. */
 static void test_caustic_matches_integral(void **state)
 {
     (void)state;
     zt_scene *s = load();
-    zt_renderer *lo = make(s, 2, 1), *hi = make(s, 2, 3);
+    zt_renderer *lo = make(s, 2, 0), *hi = make(s, 2, 2);
     assert_true(caustic_target(&lo->rs, 1));
     assert_false(caustic_target(&lo->rs, 2));
-    if (getenv("CAUSTIC_PROFILE"))
-        for (int k = -12; k <= 12; k++) {
-            vec3 x = v3(k * 0.1, 0, 0);
-            printf("x %5.2f integral %.5g map q1 %.5g q3 %.5g\n", x.x, numeric(x, 800),
-                   map_lookup_wide(&lo->forest->maps[2], 2, 0, x, 0.0).x,
-                   map_lookup_wide(&hi->forest->maps[2], 2, 0, x, 0.0).x);
-        }
-    const vec3 xs[3] = {{0.3, 0, 0.1}, {-0.5, 0, 0.2}, {0.1, 0, -0.7}};
-    double err_lo = 0, err_hi = 0;
-    for (int k = 0; k < 3; k++) {
-        double ref = numeric(xs[k], 1500);
-        double a = map_lookup_wide(&lo->forest->maps[2], 2, 0, xs[k], 0.0).x;
-        double b = map_lookup_wide(&hi->forest->maps[2], 2, 0, xs[k], 0.0).x;
-        printf("floor point %d: integral %.5g, map at quality 1: %.5g, quality 3: %.5g\n", k, ref, a,
-               b);
+    double sum_hi = 0, max_hi = 0, cusp_lo = 0, cusp_hi = 0;
+    int n = 0;
+    for (int k = -8; k <= 8; k++, n++) {
+        vec3 x = v3(0.1 * k, 0, 0.02 * k);
+        double ref = numeric(x, 600);
+        double a = map_lookup_wide(&lo->forest->maps[2], 2, 0, x, 0.0).x;
+        double b = map_lookup_wide(&hi->forest->maps[2], 2, 0, x, 0.0).x;
+        printf("x %5.2f: integral %.5g, map at quality 0: %.5g, quality 2: %.5g\n", x.x, ref, a, b);
         assert_true(ref > 1e-3);
-        err_lo += fabs(a - ref) / ref;
-        err_hi += fabs(b - ref) / ref;
-        /* Texel averages against a point value, off the caustic's cusp
-         * on the axis (where a texel's average stays 12% below it). */
-        assert_true(fabs(b - ref) < 0.04 * ref);
+        double e = fabs(b - ref) / ref;
+        sum_hi += e;
+        max_hi = fmax(max_hi, e);
+        if (k == 0) {
+            cusp_lo = fabs(a - ref) / ref;
+            cusp_hi = e;
+        }
     }
-    printf("mean relative error: quality 1 %.4f, quality 3 %.4f\n", err_lo / 3, err_hi / 3);
-    assert_true(err_hi < err_lo);
+    printf("quality 2: mean relative error %.4f, max %.4f; at the cusp %.4f (quality 0 %.4f)\n",
+           sum_hi / n, max_hi, cusp_hi, cusp_lo);
+    /* Fine cells (a quarter texel) where the caustic is concentrated, so
+     * even the cusp is within a few percent (measured: mean 1.6%, max 3.1%,
+     * cusp 1.9%; 6.7% at quality 0). */
+    assert_true(sum_hi / n < 0.025);
+    assert_true(max_hi < 0.05);
+    assert_true(cusp_hi < cusp_lo);
     zt_renderer_release(lo);
     zt_renderer_release(hi);
     zt_scene_release(s);
@@ -178,11 +178,15 @@ static void test_caustic_deterministic(void **state)
 {
     (void)state;
     zt_scene *s = load();
-    zt_renderer *a = make(s, 1, 2), *b = make(s, 2, 2);
+    zt_renderer *a = make(s, 1, 0), *b = make(s, 2, 0);
     const part_map *ma = &a->forest->maps[2], *mb = &b->forest->maps[2];
     size_t n = (size_t)ma->levels * ma->layout.sides * ma->layout.nu * ma->layout.nv * 3;
     assert_int_equal(ma->layout.nu, mb->layout.nu);
     assert_int_equal(ma->layout.nv, mb->layout.nv);
+    assert_true(ma->details > 0 && ma->details == mb->details);
+    const map_detail *da = &ma->detail[0], *db = &mb->detail[0];
+    assert_true(da->ni == db->ni && da->nj == db->nj);
+    assert_memory_equal(da->e, db->e, (size_t)da->ni * da->nj * da->sub * da->sub * 3 * sizeof(float));
     assert_memory_equal(ma->texels, mb->texels, n * sizeof(float));
     zt_renderer_release(a);
     zt_renderer_release(b);

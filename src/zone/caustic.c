@@ -16,6 +16,15 @@
 #define MEDIA_MAX 8
 #define CHUNK 1024        /* photons per work item */
 #define MIN_PHOTONS 256   /* per (light, target): a small target still gets a few */
+#define DETAIL_SUB 4      /* fine cells per texel side where a caustic is
+                             concentrated: texels above DETAIL_FRACTION of
+                             the level's brightest caustic texel that got
+                             DETAIL_PHOTONS per fine cell (fewer make a fine
+                             grid blotchy); at most DETAIL_MAX texels in the
+                             window around them, else the texels hold it */
+#define DETAIL_FRACTION 0.02
+#define DETAIL_PHOTONS 16
+#define DETAIL_MAX 4096
 
 int caustic_target(const rscene *rs, int i)
 {
@@ -27,12 +36,13 @@ int caustic_target(const rscene *rs, int i)
            m->weight[LOBE_REFRACTIVE] > 0.0f;
 }
 
-/* Irradiance added to one texel: texel `at` of part's texel array (float
- * index / 3). */
+/* Flux arriving in texel (i, j) of a part's map, at one level and side,
+ * in fine cell (su, sv) of that texel. */
 typedef struct deposit {
-    int part;
-    size_t at;
-    float e[3];
+    int part, i, j;
+    unsigned char level, side, su, sv;
+    float flux[3];
+    float dec;          /* what the windows are chosen by (make_pairs) */
 } deposit;
 
 typedef struct deposits {
@@ -41,9 +51,11 @@ typedef struct deposits {
     int failed;
 } deposits;
 
-/* One (light, target) pair and its photon count. */
+/* One (light, target) pair, its photon count and the light's emission
+ * whether switched off or not. */
 typedef struct pair {
     int light, target, photons;
+    vec3 emission;
 } pair;
 
 /* A run of photons of one pair: the unit of parallel work, whose deposits
@@ -99,7 +111,7 @@ static void bounding_sphere(const rs_part *p, vec3 *c, double *r)
     *r = fmax(v3_length(v3_sub(a, *c)), fmax(v3_length(v3_sub(b, *c)), v3_length(v3_sub(d, *c))));
 }
 
-static void push(deposits *o, int part, size_t at, vec3 e)
+static void push(deposits *o, deposit dep)
 {
     if (o->failed)
         return;
@@ -113,7 +125,7 @@ static void push(deposits *o, int part, size_t at, vec3 e)
         o->d = d;
         o->cap = cap;
     }
-    o->d[o->n++] = (deposit){part, at, {(float)e.x, (float)e.y, (float)e.z}};
+    o->d[o->n++] = dep;
 }
 
 /* Area of texel (i, j) that lies on the surface (a planar texel's cover). */
@@ -130,10 +142,10 @@ static double texel_area(const part_map *m, int i, int j)
 }
 
 /* Flux arriving at x on a mapped part, side `side`, after `level` specular
- * events: its texel's irradiance grows by flux / texel area.  Splatting
- * into the texel that holds x blurs a caustic by a texel: the maps'
- * resolution, as for every other light in them. */
-static void deposit_at(tracer *t, int part, int level, int side, vec3 x, vec3 flux)
+ * events: its texel's irradiance grows by flux / texel area (and, where
+ * the caustic is concentrated, a fine cell's by flux / cell area).
+ * Splatting into cells blurs a caustic by a cell. */
+static void deposit_at(tracer *t, int part, int level, int side, vec3 x, vec3 flux, vec3 dflux)
 {
     const part_map *m = &t->f->maps[part];
     const map_layout *l = &m->layout;
@@ -149,18 +161,24 @@ static void deposit_at(tracer *t, int part, int level, int side, vec3 x, vec3 fl
     else
         i = i < 0 ? 0 : i >= l->nu ? l->nu - 1 : i;
     j = j < 0 ? 0 : j >= l->nv ? l->nv - 1 : j;
-    double area = texel_area(m, i, j);
-    if (!(area > 0))
-        return;
-    size_t at = (((size_t)level * l->sides + side) * l->nv + j) * l->nu + i;
-    push(t->out, part, at, v3_scale(flux, 1.0 / area));
+    int su = 0, sv = 0;
+    if (l->shape != SHAPE_SPHERE) {
+        su = (int)floor((u + 0.5 - i) * DETAIL_SUB);
+        sv = (int)floor((v + 0.5 - j) * DETAIL_SUB);
+        su = su < 0 ? 0 : su >= DETAIL_SUB ? DETAIL_SUB - 1 : su;
+        sv = sv < 0 ? 0 : sv >= DETAIL_SUB ? DETAIL_SUB - 1 : sv;
+    }
+    push(t->out, (deposit){part, i, j, (unsigned char)level, (unsigned char)side,
+                           (unsigned char)su, (unsigned char)sv,
+                           {(float)flux.x, (float)flux.y, (float)flux.z},
+                           (float)v3_max(dflux)});
 }
 
 /* Follows flux along (o, d) after k specular events.  `first`: the part
  * the ray must hit first (-1: any).  `glint`: the path so far is one
  * reflection off the outside of a glint sphere, which glint.c accounts for
  * when it lands on a texel. */
-static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, int k, int glint, int first,
+static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, vec3 dflux, int k, int glint, int first,
                    const int *media, int media_count)
 {
     const rscene *rs = t->rs;
@@ -178,7 +196,7 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, int k, int glint, int
     vec3f nf = back ? f3_neg(ngf) : ngf;
     vec3 color = f3_to_v3(m->color);
     if (k >= 1 && !glint && m->weight[LOBE_DIFFUSE] > 0.0f)
-        deposit_at(t, h.part, k, back, f3_to_v3(xf), flux);
+        deposit_at(t, h.part, k, back, f3_to_v3(xf), flux, dflux);
     /* The next surface would receive k + 1 events: only while a map level
      * is left for it. */
     if (k + 1 >= t->f->map_levels)
@@ -204,8 +222,8 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, int k, int glint, int
     }
     if (k_refl > 0) {
         int g = k == 0 && !back && media_count == 0 && glint_sphere(rs, h.part);
-        follow(t, ray_offset(xf, nf), refl, v3_scale(v3_mul(flux, color), k_refl), k + 1, g, -1,
-               media, media_count);
+        follow(t, ray_offset(xf, nf), refl, v3_scale(v3_mul(flux, color), k_refl),
+               v3_scale(v3_mul(dflux, color), k_refl), k + 1, g, -1, media, media_count);
     }
     if (k_tran > 0) {
         float eta = eta_i / eta_t;
@@ -226,16 +244,18 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, int k, int glint, int
          * The radiance convention's eta^2 (zone_radiance) is what radiance
          * gains as flux is squeezed into a smaller solid angle; a photon
          * carries flux, so its gain shows as a denser splat instead. */
-        follow(t, ray_offset(xf, f3_neg(nf)), tr, v3_scale(v3_mul(flux, color), k_tran), k + 1,
-               0, -1, next, nc);
+        follow(t, ray_offset(xf, f3_neg(nf)), tr, v3_scale(v3_mul(flux, color), k_tran),
+               v3_scale(v3_mul(dflux, color), k_tran), k + 1, 0, -1, next, nc);
     }
 }
 
 /* Photon i of n of a pair: a point on the light (a triangle uniformly; a
  * sphere over the cap that can see the target) and a direction towards the
  * target (uniform in a sphere's cone, or to a uniform point of a
- * triangle), from a 4-d Hammersley set whose best-spread pair of
- * coordinates picks the direction (what shapes a caustic).  Flux =
+ * triangle), from the 4-d Halton set (bases 2, 3 for the direction, what
+ * shapes a caustic; 5, 7 for the point).  Not Hammersley: its (i/n, base
+ * 2) pair is a near-regular grid, which the lens maps onto the fine cells
+ * as moire (errors of 6% at 2^19 photons where 2^18 gave 2%).  Flux =
  * radiance x cos at the light x light area x (cone solid angle, or a
  * triangle's area-to-solid-angle factor) / n. */
 static void shoot(tracer *t, const pair *pr, int i)
@@ -243,8 +263,9 @@ static void shoot(tracer *t, const pair *pr, int i)
     const rscene *rs = t->rs;
     const rs_part *lp = &rs->parts[pr->light], *tp = &rs->parts[pr->target];
     int n = pr->photons;
-    double u1 = (i + 0.5) / n, u2 = radical_inverse((uint32_t)i, 2);
-    double u3 = radical_inverse((uint32_t)i, 3), u4 = radical_inverse((uint32_t)i, 5);
+    uint32_t h = (uint32_t)i + 1;
+    double u1 = radical_inverse(h, 2), u2 = radical_inverse(h, 3);
+    double u3 = radical_inverse(h, 5), u4 = radical_inverse(h, 7);
     vec3 ct;
     double rt;
     bounding_sphere(tp, &ct, &rt);
@@ -305,17 +326,21 @@ static void shoot(tracer *t, const pair *pr, int i)
     if (!(cy > 0))
         return;
     vec3f wf = v3_to_f3(w);
-    vec3f le = light_emitted(rs, lp, v3_to_f3(y), f3_neg(wf));
-    if (f3_is_black(le))
+    /* A switched-off light's photons carry no flux but are traced all the
+     * same, with its emission as the flux that chooses the windows: the
+     * windows, and so the images of single lights, add up. */
+    if (lp->culled && f3_dot(shape_normal(lp, v3_to_f3(y)), f3_neg(wf)) >= 0.0f)
         return;
-    vec3 flux = v3_scale(f3_to_v3(le), cy * g * area / n);
-    follow(t, ray_offset(v3_to_f3(y), v3_to_f3(side)), wf, flux, 0, 0, pr->target, NULL, 0);
+    vec3f le = light_emitted(rs, lp, v3_to_f3(y), f3_neg(wf));
+    double scale = cy * g * area / n;
+    vec3 flux = v3_scale(f3_to_v3(le), scale), dflux = v3_scale(pr->emission, scale);
+    follow(t, ray_offset(v3_to_f3(y), v3_to_f3(side)), wf, flux, dflux, 0, 0, pr->target, NULL, 0);
 }
 
 /* Photons per pair: the light's budget shared by how much of its light
  * each target can catch (solid angle from the light's centre x specular
  * weight x colour), at least MIN_PHOTONS. */
-static int make_pairs(const zone_forest *f, const rscene *rs, pair **out)
+static int make_pairs(const zone_forest *f, const zt_scene *sc, const rscene *rs, pair **out)
 {
     int cap = 16, count = 0;
     pair *ps = malloc((size_t)cap * sizeof *ps);
@@ -325,11 +350,11 @@ static int make_pairs(const zone_forest *f, const rscene *rs, pair **out)
         free(imp);
         return -1;
     }
-    for (int j = 0; j < rs->light_count; j++) {
-        int li = rs->lights[j].part;
+    for (int li = 0; li < rs->part_count; li++) {
         const rs_part *lp = &rs->parts[li];
-        if ((lp->shape != SHAPE_TRIANGLE && lp->shape != SHAPE_SPHERE) ||
-            f3_is_black(rs->objects[lp->object].emission))
+        vec3 em = sc->objects[lp->object].emission;
+        if (!lp->is_light || (lp->shape != SHAPE_TRIANGLE && lp->shape != SHAPE_SPHERE) ||
+            !(v3_max(em) > 0))
             continue;
         vec3 cl, ct;
         double rl, rt, total = 0;
@@ -364,12 +389,182 @@ static int make_pairs(const zone_forest *f, const rscene *rs, pair **out)
             }
             double share = (double)f->q.photons * imp[i] / total;
             int n = share < MIN_PHOTONS ? MIN_PHOTONS : (int)(share + 0.5);
-            ps[count++] = (pair){li, i, n};
+            ps[count++] = (pair){li, i, n, em};
         }
     }
     free(imp);
     *out = ps;
     return count;
+}
+
+/* Whether a texel's caustic is bright enough and got photons enough for
+ * fine cells. */
+static int fine_enough(double e, unsigned count, double top)
+{
+    return e >= DETAIL_FRACTION * top &&
+           count >= DETAIL_PHOTONS * DETAIL_SUB * DETAIL_SUB;
+}
+
+static size_t map_floats(const part_map *m)
+{
+    return (size_t)m->levels * m->layout.sides * m->layout.nu * m->layout.nv * 3;
+}
+
+static size_t texel_index(const part_map *m, int level, int side, int i, int j)
+{
+    const map_layout *l = &m->layout;
+    return (((size_t)level * l->sides + side) * l->nv + j) * l->nu + i;
+}
+
+/* Area of fine cell (su, sv) of planar texel (i, j) that lies on the
+ * surface. */
+static double cell_area(const part_map *m, int i, int j, int su, int sv)
+{
+    const map_layout *l = &m->layout;
+    double s0 = axis_edge(&l->au, i), s1 = axis_edge(&l->au, i + 1);
+    double t0 = axis_edge(&l->av, j), t1 = axis_edge(&l->av, j + 1);
+    double a0 = s0 + (s1 - s0) * su / DETAIL_SUB, a1 = s0 + (s1 - s0) * (su + 1) / DETAIL_SUB;
+    double b0 = t0 + (t1 - t0) * sv / DETAIL_SUB, b1 = t0 + (t1 - t0) * (sv + 1) / DETAIL_SUB;
+    double whole = v3_length(v3_cross(l->du, l->dv)) * (a1 - a0) * (b1 - b0);
+    if (m->cover[(size_t)j * l->nu + i] >= 1.0f)
+        return whole;
+    vec3 q[2 * MAP_CLIPS + 8];
+    q[0] = map_point(l, a0, b0);
+    q[1] = map_point(l, a1, b0);
+    q[2] = map_point(l, a1, b1);
+    q[3] = map_point(l, a0, b1);
+    int n = 4;
+    for (int k = 0; k < l->clips && n >= 3; k++)
+        n = poly3_clip(q, n, 2 * MAP_CLIPS + 8, l->clip_n[k], l->clip_d[k]);
+    vec3 sum = v3(0, 0, 0);
+    for (int k = 1; k + 1 < n; k++)
+        sum = v3_add(sum, v3_cross(v3_sub(q[k], q[0]), v3_sub(q[k + 1], q[0])));
+    return n >= 3 ? 0.5 * v3_length(sum) : 0.0;
+}
+
+/* Where a level's caustic on planar part p is concentrated, a window of
+ * fine cells takes it, made from the same deposits in the same order; the
+ * level's coarse caustic is kept apart too (caustic_finish).  acc: the
+ * caustic's texels; count: photons per texel.  Returns 0 when out of
+ * memory. */
+static int make_details(zone_forest *f, int p, const double *acc, const double *dacc,
+                        const unsigned *count, const job *jobs, int njobs)
+{
+    part_map *m = &f->maps[p];
+    const map_layout *l = &m->layout;
+    size_t cells = (size_t)l->nu * l->nv;
+    int first = m->details;
+    for (int level = 1; level < f->map_levels; level++)
+        for (int side = 0; side < l->sides; side++) {
+            size_t base = texel_index(m, level, side, 0, 0);
+            const double *a = acc + 3 * base, *da = dacc + base;
+            const unsigned *cn = count + base;
+            double top = 0;
+            for (size_t k = 0; k < cells; k++)
+                top = fmax(top, da[k]);
+            if (!(top > 0))
+                continue;
+            /* The texels fine enough, and one around them: the coarse
+             * caustic read bilinearly beside a bright texel would carry
+             * half of it a texel too far. */
+            unsigned char *ok = calloc(cells, 1);
+            if (!ok)
+                return 0;
+            for (int j = 0; j < l->nv; j++)
+                for (int i = 0; i < l->nu; i++) {
+                    size_t k = (size_t)j * l->nu + i;
+                    if (!fine_enough(da[k], cn[k], top))
+                        continue;
+                    for (int dj = -1; dj <= 1; dj++)
+                        for (int di = -1; di <= 1; di++)
+                            if (i + di >= 0 && i + di < l->nu && j + dj >= 0 && j + dj < l->nv)
+                                ok[(size_t)(j + dj) * l->nu + i + di] = 1;
+                }
+            int i0 = l->nu, i1 = -1, j0 = l->nv, j1 = -1;
+            for (int j = 0; j < l->nv; j++)
+                for (int i = 0; i < l->nu; i++) {
+                    if (!ok[(size_t)j * l->nu + i])
+                        continue;
+                    i0 = i < i0 ? i : i0, i1 = i > i1 ? i : i1;
+                    j0 = j < j0 ? j : j0, j1 = j > j1 ? j : j1;
+                }
+            int ni = i1 - i0 + 1, nj = j1 - j0 + 1;
+            if (i1 < 0 || ni * nj > DETAIL_MAX) {
+                free(ok);
+                continue;
+            }
+            map_detail *nd = realloc(m->detail, (size_t)(m->details + 1) * sizeof *nd);
+            if (!nd) {
+                free(ok);
+                return 0;
+            }
+            m->detail = nd;
+            map_detail *d = &m->detail[m->details++];
+            *d = (map_detail){level, side, i0, j0, ni, nj, DETAIL_SUB, NULL, NULL, NULL};
+            d->use = malloc((size_t)ni * nj);
+            d->e = calloc((size_t)ni * nj * DETAIL_SUB * DETAIL_SUB * 3, sizeof(float));
+            d->coarse = malloc(cells * 3 * sizeof(float));
+            if (!d->use || !d->e || !d->coarse) {
+                free(ok);
+                return 0;
+            }
+            for (size_t k = 0; k < cells * 3; k++)
+                d->coarse[k] = (float)a[k];
+            for (int j = 0; j < nj; j++)
+                for (int i = 0; i < ni; i++) {
+                    size_t k = (size_t)(j0 + j) * l->nu + i0 + i;
+                    d->use[(size_t)j * ni + i] = ok[k];
+                }
+            free(ok);
+        }
+    for (int k = first; k < m->details; k++) {
+        map_detail *d = &m->detail[k];
+        int fu = d->ni * d->sub;
+        size_t n = (size_t)fu * d->nj * d->sub * 3;
+        double *fine = calloc(n, sizeof(double));
+        if (!fine)
+            return 0;
+        for (int q = 0; q < njobs; q++)
+            for (size_t x = 0; x < jobs[q].out.n; x++) {
+                const deposit *dp = &jobs[q].out.d[x];
+                if (dp->part != p || dp->level != d->level || dp->side != d->side ||
+                    dp->i < d->i0 || dp->i >= d->i0 + d->ni || dp->j < d->j0 ||
+                    dp->j >= d->j0 + d->nj)
+                    continue;
+                double area = cell_area(m, dp->i, dp->j, dp->su, dp->sv);
+                if (!(area > 0))
+                    continue;
+                size_t at = 3 * ((size_t)((dp->j - d->j0) * d->sub + dp->sv) * fu +
+                                 (size_t)((dp->i - d->i0) * d->sub + dp->su));
+                for (int c = 0; c < 3; c++)
+                    fine[at + c] += dp->flux[c] / area;
+            }
+        for (size_t x = 0; x < n; x++)
+            d->e[x] = (float)fine[x];
+        free(fine);
+    }
+    return 1;
+}
+
+int caustic_finish(zone_forest *f)
+{
+    for (int p = 0; p < f->map_count; p++) {
+        part_map *m = &f->maps[p];
+        if (!m->details)
+            continue;
+        size_t cells = (size_t)m->layout.nu * m->layout.nv;
+        for (int k = 0; k < m->details; k++) {
+            const map_detail *d = &m->detail[k];
+            float *px = map_texel(m, d->level, d->side, 0, 0);
+            for (size_t i = 0; i < cells * 3; i++)
+                px[i] -= d->coarse[i];
+        }
+        for (int k = 0; k < m->details; k++)
+            if (!map_build_mips(m, m->detail[k].level))
+                return 0;
+        m->detail_live = 1;
+    }
+    return 1;
 }
 
 zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
@@ -378,7 +573,7 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
     if (f->map_levels < 2)
         return ZT_OK;
     pair *pairs = NULL;
-    int npairs = make_pairs(f, rs, &pairs);
+    int npairs = make_pairs(f, r->scene, rs, &pairs);
     if (npairs < 0)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for caustics");
     int njobs = 0;
@@ -386,10 +581,14 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
         njobs += (pairs[k].photons + CHUNK - 1) / CHUNK;
     job *jobs = calloc((size_t)njobs + 1, sizeof *jobs);
     double **acc = calloc((size_t)f->map_count + 1, sizeof *acc);
-    if (!jobs || !acc) {
+    double **dacc = calloc((size_t)f->map_count + 1, sizeof *dacc);
+    unsigned **count = calloc((size_t)f->map_count + 1, sizeof *count);
+    if (!jobs || !acc || !dacc || !count) {
         free(pairs);
         free(jobs);
         free(acc);
+        free(dacc);
+        free(count);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for caustics");
     }
     njobs = 0;
@@ -417,26 +616,40 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
             const deposit *d = &o->d[i];
             const part_map *m = &f->maps[d->part];
             if (!acc[d->part]) {
-                size_t n = (size_t)m->levels * m->layout.sides * m->layout.nu * m->layout.nv * 3;
-                acc[d->part] = calloc(n, sizeof(double));
-                if (!acc[d->part]) {
+                acc[d->part] = calloc(map_floats(m), sizeof(double));
+                dacc[d->part] = calloc(map_floats(m) / 3, sizeof(double));
+                count[d->part] = calloc(map_floats(m) / 3, sizeof(unsigned));
+                if (!acc[d->part] || !dacc[d->part] || !count[d->part]) {
                     failed = 1;
                     break;
                 }
             }
+            double area = texel_area(m, d->i, d->j);
+            if (!(area > 0))
+                continue;
+            size_t at = texel_index(m, d->level, d->side, d->i, d->j);
+            count[d->part][at]++;
+            dacc[d->part][at] += d->dec / area;
             for (int c = 0; c < 3; c++)
-                acc[d->part][d->at * 3 + c] += d->e[c];
+                acc[d->part][3 * at + c] += d->flux[c] / area;
         }
     }
+    for (int p = 0; p < f->map_count && !failed; p++)
+        if (acc[p] && f->maps[p].layout.shape != SHAPE_SPHERE)
+            failed = !make_details(f, p, acc[p], dacc[p], count[p], jobs, njobs);
     for (int p = 0; p < f->map_count; p++) {
         if (acc[p] && !failed) {
             const part_map *m = &f->maps[p];
-            size_t n = (size_t)m->levels * m->layout.sides * m->layout.nu * m->layout.nv * 3;
+            size_t n = map_floats(m);
             for (size_t i = 0; i < n; i++)
                 m->texels[i] += (float)acc[p][i];
         }
         free(acc[p]);
+        free(dacc[p]);
+        free(count[p]);
     }
+    free(dacc);
+    free(count);
     for (int k = 0; k < njobs; k++)
         free(jobs[k].out.d);
     free(acc);

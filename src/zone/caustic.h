@@ -31,4 +31,9 @@ int caustic_target(const rscene *rs, int i);
  * count.  Counts its rays in f->rays. */
 zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err);
 
+/* After the last level: takes the caustics kept apart (map_detail) out of
+ * the texels and lets reads add them instead, finely where they are
+ * concentrated.  Returns 0 when out of memory. */
+int caustic_finish(zone_forest *f);
+
 #endif

@@ -425,6 +425,8 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
         }
     }
     f->rays += rays;
+    if (!caustic_finish(f))
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
     /* What only the transfer needed goes: Phase Two reads texels, weights
      * and their coarser copies, as a forest read from a file does. */
     for (int i = 0; i < sc->part_count; i++)

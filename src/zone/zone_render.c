@@ -26,7 +26,7 @@ zone_quality zone_quality_for(const zt_scene *sc, int q)
     z.sides = 16 << (q / 2);
     z.aa = q < 3 ? 1 : 2;
     z.glint_cuts = 2 << (q / 2);
-    z.photons = 16384 << q;
+    z.photons = 131072 << q;
     z.theta = 0.5 / step;
     return z;
 }
