@@ -21,8 +21,8 @@
 #include "zone/zone_internal.h"
 
 /* Whether the photons start at part i: a non-light part, not a plane, that
- * has a specular lobe.  A gather ray that meets a light right after such a
- * part (and after no diffuse event) counts nothing. */
+ * has a specular lobe.  A gather ray that meets a triangle or sphere light
+ * right after such a part (and after no diffuse event) counts nothing. */
 int caustic_target(const rscene *rs, int i);
 
 /* Adds the caustic irradiance of levels 1..f->map_levels-1 into the maps'
