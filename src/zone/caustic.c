@@ -23,6 +23,11 @@
                              grid blotchy); at most DETAIL_MAX texels in the
                              window around them, else the texels hold it */
 #define DETAIL_FRACTION 0.02
+#define BRANCH_MIN 1e-3   /* a branch whose share of its photon's flux falls
+                             below this is dropped: glass splits every ray in
+                             two, and deep levels would otherwise follow 2^k
+                             branches per photon (what is dropped is lost) */
+#define LEVEL_MAX 250     /* deposits keep their level in a byte */
 #define DETAIL_PHOTONS 16
 #define DETAIL_MAX 4096
 
@@ -178,8 +183,8 @@ static void deposit_at(tracer *t, int part, int level, int side, vec3 x, vec3 fl
  * the ray must hit first (-1: any).  `glint`: the path so far is one
  * reflection off the outside of a glint sphere, which glint.c accounts for
  * when it lands on a texel. */
-static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, vec3 dflux, int k, int glint, int first,
-                   const int *media, int media_count)
+static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, vec3 dflux, double share, int k,
+                   int glint, int first, const int *media, int media_count)
 {
     const rscene *rs = t->rs;
     hit h = accel_intersect(rs, o, d);
@@ -199,7 +204,7 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, vec3 dflux, int k, in
         deposit_at(t, h.part, k, back, f3_to_v3(xf), flux, dflux);
     /* The next surface would receive k + 1 events: only while a map level
      * is left for it. */
-    if (k + 1 >= t->f->map_levels)
+    if (k + 1 >= t->f->map_levels || k + 1 > LEVEL_MAX)
         return;
     float wm = m->weight[LOBE_METALLIC], wr = m->weight[LOBE_REFLECTING];
     float wt = m->weight[LOBE_REFRACTIVE];
@@ -220,12 +225,14 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, vec3 dflux, int k, in
         k_refl += wt * fr;
         k_tran = wt * (1.0 - fr);
     }
-    if (k_refl > 0) {
+    double cmax = v3_max(color);
+    if (k_refl > 0 && share * k_refl * cmax >= BRANCH_MIN) {
         int g = k == 0 && !back && media_count == 0 && glint_sphere(rs, h.part);
         follow(t, ray_offset(xf, nf), refl, v3_scale(v3_mul(flux, color), k_refl),
-               v3_scale(v3_mul(dflux, color), k_refl), k + 1, g, -1, media, media_count);
+               v3_scale(v3_mul(dflux, color), k_refl), share * k_refl * cmax, k + 1, g, -1, media,
+               media_count);
     }
-    if (k_tran > 0) {
+    if (k_tran > 0 && share * k_tran * cmax >= BRANCH_MIN) {
         float eta = eta_i / eta_t;
         float sin2 = eta * eta * (1.0f - cos_o * cos_o);
         float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2));
@@ -245,7 +252,8 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, vec3 dflux, int k, in
          * gains as flux is squeezed into a smaller solid angle; a photon
          * carries flux, so its gain shows as a denser splat instead. */
         follow(t, ray_offset(xf, f3_neg(nf)), tr, v3_scale(v3_mul(flux, color), k_tran),
-               v3_scale(v3_mul(dflux, color), k_tran), k + 1, 0, -1, next, nc);
+               v3_scale(v3_mul(dflux, color), k_tran), share * k_tran * cmax, k + 1, 0, -1, next,
+               nc);
     }
 }
 
@@ -334,7 +342,8 @@ static void shoot(tracer *t, const pair *pr, int i)
     vec3f le = light_emitted(rs, lp, v3_to_f3(y), f3_neg(wf));
     double scale = cy * g * area / n;
     vec3 flux = v3_scale(f3_to_v3(le), scale), dflux = v3_scale(pr->emission, scale);
-    follow(t, ray_offset(v3_to_f3(y), v3_to_f3(side)), wf, flux, dflux, 0, 0, pr->target, NULL, 0);
+    follow(t, ray_offset(v3_to_f3(y), v3_to_f3(side)), wf, flux, dflux, 1.0, 0, 0, pr->target,
+           NULL, 0);
 }
 
 /* Photons per pair: the light's budget shared by how much of its light
