@@ -23,13 +23,13 @@
                              grid blotchy); at most DETAIL_MAX texels in the
                              window around them, else the texels hold it */
 #define DETAIL_FRACTION 0.02
+#define DETAIL_PHOTONS 16
+#define DETAIL_MAX 4096
 #define BRANCH_MIN 1e-3   /* a branch whose share of its photon's flux falls
                              below this is dropped: glass splits every ray in
                              two, and deep levels would otherwise follow 2^k
                              branches per photon (what is dropped is lost) */
 #define LEVEL_MAX 250     /* deposits keep their level in a byte */
-#define DETAIL_PHOTONS 16
-#define DETAIL_MAX 4096
 
 int caustic_target(const rscene *rs, int i)
 {

@@ -12,7 +12,8 @@
  * every specular interaction (glass: both the reflected and the transmitted
  * ray, with Fresnel weights).  Where a ray meets a mapped diffuse surface
  * after k >= 1 specular events, its flux over the texel's area is added to
- * E_k of that texel.  The gathers leave exactly these chains out
+ * E_k of that texel (and over a fine cell's area to a quarter-texel grid
+ * where the caustic is concentrated: map_detail in zone_maps.h).  The gathers leave exactly these chains out
  * (ZR_NO_CAUSTIC), and the one reflection off a glint sphere straight onto
  * a texel stays with glint.c. */
 #ifndef ZT_ZONE_CAUSTIC_H
