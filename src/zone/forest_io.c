@@ -245,6 +245,11 @@ static int derive_level(part_map *m, int level)
     return map_build_mips(m, level);
 }
 
+static size_t detail_values(const map_detail *d)
+{
+    return (size_t)d->ni * d->sub * d->nj * d->sub * 3;
+}
+
 static void w_axis(wbuf *w, const map_axis *a)
 {
     w_i32(w, a->n);
@@ -350,6 +355,21 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
             }
             w_f32s(&w, m->alt, mip_values(m, 0));
             w_f32s(&w, m->alt_weight, mip_weights(m, 0));
+        }
+        /* Caustics kept apart (caustic.c). */
+        w_i32(&w, m->details);
+        for (int k = 0; k < m->details; k++) {
+            const map_detail *d = &m->detail[k];
+            w_i32(&w, d->level);
+            w_i32(&w, d->side);
+            w_i32(&w, d->i0);
+            w_i32(&w, d->j0);
+            w_i32(&w, d->ni);
+            w_i32(&w, d->nj);
+            w_i32(&w, d->sub);
+            w_bytes(&w, d->use, (size_t)d->ni * d->nj);
+            w_f32s(&w, d->e, detail_values(d));
+            w_f32s(&w, d->coarse, (size_t)l->nu * l->nv * 3);
         }
     }
     /* File size and checksum. */
@@ -671,6 +691,52 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
         for (int level = 0; level < m->levels; level++)
             if (!derive_level(m, level))
                 return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+        int details = r_i32(rb);
+        if (rb->short_read)
+            return ZT_ERR_PARSE;
+        if (details < 0 || details > 2 * f->map_levels || (details && l->shape == SHAPE_SPHERE))
+            return corrupt(err, path, "bad caustic window count");
+        m->detail = calloc((size_t)details + 1, sizeof(map_detail));
+        if (!m->detail)
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+        for (int k = 0; k < details; k++) {
+            map_detail *d = &m->detail[k];
+            m->details = k + 1; /* freed with the map from here on */
+            d->level = r_i32(rb);
+            d->side = r_i32(rb);
+            d->i0 = r_i32(rb);
+            d->j0 = r_i32(rb);
+            d->ni = r_i32(rb);
+            d->nj = r_i32(rb);
+            d->sub = r_i32(rb);
+            if (rb->short_read)
+                return ZT_ERR_PARSE;
+            if (d->level < 1 || d->level >= f->map_levels || d->side < 0 || d->side >= l->sides ||
+                d->i0 < 0 || d->ni < 1 || d->ni > l->nu - d->i0 || d->j0 < 0 || d->nj < 1 ||
+                d->nj > l->nv - d->j0 || d->sub < 1 || d->sub > 64)
+                return corrupt(err, path, "bad caustic window");
+            size_t nuse = (size_t)d->ni * d->nj;
+            if (nuse > rb->n - rb->at) {
+                rb->short_read = 1;
+                return ZT_ERR_PARSE;
+            }
+            d->use = malloc(nuse);
+            if (!d->use)
+                return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+            for (size_t k2 = 0; k2 < nuse; k2++) {
+                d->use[k2] = rb->b[rb->at++];
+                if (d->use[k2] > 1)
+                    return corrupt(err, path, "bad caustic window");
+            }
+            d->e = r_f32s(rb, detail_values(d), &oom);
+            if (d->e)
+                d->coarse = r_f32s(rb, (size_t)l->nu * l->nv * 3, &oom);
+            if (oom)
+                return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+            if (rb->short_read)
+                return ZT_ERR_PARSE;
+        }
+        m->detail_live = 1;
     }
     return ZT_OK;
 }
@@ -888,6 +954,10 @@ void forest_memory(const zone_forest *f, uint64_t *zones, uint64_t *occluders, u
             mb += (mip_values(m, 0) + mip_weights(m, 0)) * sizeof(float) +
                   (size_t)m->layout.nu * m->layout.nv * 2 +
                   (size_t)m->crossings * sizeof *m->cross;
+        for (int k = 0; k < m->details; k++)
+            mb += sizeof(map_detail) + (size_t)m->detail[k].ni * m->detail[k].nj +
+                  (detail_values(&m->detail[k]) + mip_values(m, 0) / m->levels / m->layout.sides) *
+                      sizeof(float);
     }
     *maps = mb;
 }

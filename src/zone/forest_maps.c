@@ -12,6 +12,7 @@
 #include "geom/shapes.h"
 #include "util/error.h"
 #include "util/vec3_convert.h"
+#include "zone/caustic.h"
 #include "zone/glint.h"
 #include "zone/map_layout.h"
 #include "zone/transfer.h"
@@ -160,7 +161,7 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
             l = h.part < 0 ? v3(rs->sky.x, rs->sky.y, rs->sky.z) : v3(0, 0, 0);
         } else {
             l = zone_radiance(t, o, v3_to_f3(v3_normalize(d)), level, level,
-                              ZR_SKIP_FLAT_DIFFUSE | ZR_NO_GLINT, NULL, 0);
+                              ZR_SKIP_FLAT_DIFFUSE | ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0);
         }
         sum = v3_add(sum, l);
     }
@@ -423,6 +424,11 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
             }
         }
     }
+    /* Light by way of specular surfaces, traced from the lights into the
+     * texels of levels 1 and up; the level loop below adds the rest. */
+    zt_status cst = caustic_build(f, r, err);
+    if (cst != ZT_OK)
+        return cst;
     int threads = render_thread_count(r->options.threads);
     uint64_t rays = 0;
     int last = f->sky_slot >= 0 ? f->sky_slot : f->map_levels - 1;
@@ -448,9 +454,9 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                                                     : texel_value(&t, f, i, level, x, n, dirs,
                                                                   f->q.theta * texel_growth(m, u, j));
                     float *px = map_texel(m, level, side, u, j);
-                    px[0] = (float)e.x;
-                    px[1] = (float)e.y;
-                    px[2] = (float)e.z;
+                    px[0] += (float)e.x; /* onto the caustics (caustic.c) */
+                    px[1] += (float)e.y;
+                    px[2] += (float)e.z;
                     size_t k = (size_t)j * m->layout.nu + u;
                     if (m->crossings && m->cut[k] >= 0) {
                         size_t ka = (size_t)side * m->layout.nv * m->layout.nu + k;
@@ -475,6 +481,8 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
         }
     }
     f->rays += rays;
+    if (!caustic_finish(f))
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
     /* What only the transfer needed goes: Phase Two reads texels, weights
      * and their coarser copies, as a forest read from a file does. */
     for (int i = 0; i < sc->part_count; i++)

@@ -48,6 +48,7 @@ typedef struct zone_quality {
     int edge_shade;     /* its shaded subset, per side (divides edge_grid) */
     int probe;          /* signatures per side that look for an edge in a
                            pixel (no more than aa: the samples' own) */
+    int photons;        /* caustic photons per light (caustic.h) */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;
@@ -110,8 +111,15 @@ enum {
                             camera's level 0 is measured analytically) */
     ZR_SKIP_FLAT_DIFFUSE = 4, /* the diffuse lobe of a flat part hit by this
                             very ray counts nothing (transfer covers it) */
-    ZR_NO_GLINT = 8      /* a light seen in a glint sphere (glint.h) by this
+    ZR_NO_GLINT = 8,     /* a light seen in a glint sphere (glint.h) by this
                             very ray counts nothing (its image covers it) */
+    ZR_NO_CAUSTIC = 16,  /* a light reached after one or more specular events
+                            and no diffuse one, the last of them off a
+                            caustic target (caustic.h), counts nothing if it
+                            sends photons (a triangle or sphere): they carry
+                            it */
+    ZR_CAUSTIC_LIGHT = 32 /* set by zone_radiance under ZR_NO_CAUSTIC: this
+                            very ray left a caustic target */
 };
 vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count);

@@ -372,20 +372,19 @@ static void axis_pick(double u, int n, int wrap, int extend, int *i0, int *i1, d
     *f = u - a;
 }
 
-/* Bilinear read of one level and side of mip k at normalised (s, t).  On
+/* Bilinear read at normalised (s, t) of the grid `base` (mip k of one
+ * level and side; alt the other halves of its cut texels, or NULL).  On
  * the finest grid of a map with crossings, x (the point read) decides
  * which half of a cut texel is read, and texels a crossing separates from
  * x do not take part: the light jumps there and must not be smeared. */
-static vec3 bilinear(const part_map *m, int k, int level, int side, double s, double t,
-                     const vec3 *x)
+static vec3 bilinear_of(const part_map *m, int k, const float *base, const float *alt_base,
+                        int side, double s, double t, const vec3 *x)
 {
     const map_layout *l = &m->layout;
     int nu = mip_size(l->nu, k), nv = mip_size(l->nv, k);
-    size_t plane = ((size_t)level * l->sides + side) * (size_t)nv * nu;
-    const float *base = m->mip[k] + plane * 3;
     const float *wt = m->weight[k] + (size_t)side * nv * nu;
-    int cross = k == 0 && x && m->crossings > 0;
-    const float *alt = cross ? m->alt + plane * 3 : NULL;
+    int cross = k == 0 && x && alt_base && m->crossings > 0;
+    const float *alt = cross ? alt_base : NULL;
     const float *awt = cross ? m->alt_weight + (size_t)side * nv * nu : NULL;
     double u = s * nu - 0.5, v = t * nv - 0.5;
     int wrap = l->shape == SHAPE_SPHERE;
@@ -451,6 +450,52 @@ static vec3 bilinear(const part_map *m, int k, int level, int side, double s, do
     return v3(0, 0, 0);
 }
 
+static vec3 bilinear(const part_map *m, int k, int level, int side, double s, double t,
+                     const vec3 *x)
+{
+    const map_layout *l = &m->layout;
+    int nu = mip_size(l->nu, k), nv = mip_size(l->nv, k);
+    size_t plane = ((size_t)level * l->sides + side) * (size_t)nv * nu;
+    return bilinear_of(m, k, m->mip[k] + plane * 3, m->alt ? m->alt + plane * 3 : NULL, side, s,
+                       t, x);
+}
+
+/* Bilinear between fine cell centres (held at the window's edge cells). */
+static vec3 fine_read(const map_detail *d, double U, double V)
+{
+    int nu = d->ni * d->sub, nv = d->nj * d->sub;
+    double fu = fmax(0.0, fmin(U * d->sub - 0.5, nu - 1.0));
+    double fv = fmax(0.0, fmin(V * d->sub - 0.5, nv - 1.0));
+    int a = (int)fu, b = (int)fv;
+    int a1 = a + 1 < nu ? a + 1 : a, b1 = b + 1 < nv ? b + 1 : b;
+    double x = fu - a, y = fv - b;
+    const float *e = d->e;
+    const float *p00 = e + ((size_t)b * nu + a) * 3, *p10 = e + ((size_t)b * nu + a1) * 3;
+    const float *p01 = e + ((size_t)b1 * nu + a) * 3, *p11 = e + ((size_t)b1 * nu + a1) * 3;
+    double w00 = (1 - x) * (1 - y), w10 = x * (1 - y), w01 = (1 - x) * y, w11 = x * y;
+    return v3(w00 * p00[0] + w10 * p10[0] + w01 * p01[0] + w11 * p11[0],
+              w00 * p00[1] + w10 * p10[1] + w01 * p01[1] + w11 * p11[1],
+              w00 * p00[2] + w10 * p10[2] + w01 * p01[2] + w11 * p11[2]);
+}
+
+/* The caustics of a level and side at grid point (u, v) (texel units, as
+ * map_coords gives them; s, t normalised). */
+static vec3 detail_sum(const part_map *m, int level, int side, double u, double v, double s,
+                       double t)
+{
+    vec3 e = v3(0, 0, 0);
+    for (int k = 0; k < m->details; k++) {
+        const map_detail *d = &m->detail[k];
+        if (d->level != level || d->side != side)
+            continue;
+        double U = u + 0.5 - d->i0, V = v + 0.5 - d->j0;
+        int inside = U >= 0 && V >= 0 && U < d->ni && V < d->nj &&
+                     d->use[(size_t)(int)V * d->ni + (int)U];
+        e = v3_add(e, inside ? fine_read(d, U, V) : bilinear_of(m, 0, d->coarse, NULL, side, s, t, NULL));
+    }
+    return e;
+}
+
 vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double width)
 {
     const map_layout *l = &m->layout;
@@ -460,6 +505,11 @@ vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double widt
         side = l->sides - 1;
     double u, v;
     map_coords(l, p, &u, &v);
+    /* The caustics kept apart, once they have left the texels (the wide
+     * reads of Phase One's gathers come before that and find them there). */
+    vec3 detail = m->details && m->detail_live
+                      ? detail_sum(m, level, side, u, v, (u + 0.5) / l->nu, (v + 0.5) / l->nv)
+                      : v3(0, 0, 0);
     double s = (u + 0.5) / l->nu, t = (v + 0.5) / l->nv;
     double texel = l->shape == SHAPE_SPHERE
                        ? 3.14159265358979 * l->radius / l->nv
@@ -470,10 +520,10 @@ vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double widt
     int k0 = (int)lod;
     vec3 a = bilinear(m, k0, level, side, s, t, &p);
     if (k0 + 1 >= m->mips || lod == k0)
-        return a;
+        return v3_add(a, detail);
     vec3 b = bilinear(m, k0 + 1, level, side, s, t, &p);
     double f = lod - k0;
-    return v3_add(v3_scale(a, 1 - f), v3_scale(b, f));
+    return v3_add(v3_add(v3_scale(a, 1 - f), v3_scale(b, f)), detail);
 }
 
 int map_build_mips(part_map *m, int level)
@@ -544,6 +594,12 @@ void map_free_phase_one(part_map *m)
 
 void map_free(part_map *m)
 {
+    for (int k = 0; k < m->details; k++) {
+        free(m->detail[k].use);
+        free(m->detail[k].e);
+        free(m->detail[k].coarse);
+    }
+    free(m->detail);
     free(m->layout.au.edge);
     free(m->layout.av.edge);
     free(m->texels);

@@ -60,6 +60,22 @@ typedef struct map_crossing {
     double d;
     int part;           /* the piercing part */
 } map_crossing;
+/* One level and side's caustic (caustic.c), kept apart from the texels
+ * once Phase One is done, with a finer grid where it is concentrated: a
+ * light focused by glass is often narrower than a texel, and a texel's
+ * average read back bilinearly would smear it over three.  A read adds,
+ * inside a texel marked in the window, the fine grid's value; elsewhere
+ * the caustic's own texels, interpolated like the map's. */
+typedef struct map_detail {
+    int level, side;
+    int i0, j0, ni, nj; /* the window: texels [i0, i0+ni) x [j0, j0+nj) */
+    int sub;            /* fine cells per texel side */
+    unsigned char *use; /* per window texel: 1 where the fine grid holds enough
+                           photons to be read */
+    float *e;           /* fine irradiance [nj*sub][ni*sub][rgb] */
+    float *coarse;      /* the caustic per texel of the whole map [nv][nu][rgb],
+                           in the texels too until caustic_finish takes it out */
+} map_detail;
 
 /* The grid of one part: texel values for each level and side, and coarser
  * copies (each halving the resolution) for lookups that stand for a wide
@@ -97,6 +113,8 @@ typedef struct part_map {
     /* Summed-area tables per level and side: [level][side][(nv+1)*(nu+1)]
      * of area*weight*rgb (3 doubles) and area, built by transfer.c. */
     double *sat;
+    map_detail *detail; /* caustics apart; read once detail_live */
+    int details, detail_live;
 } part_map;
 
 /* Texel centre (i, j) of the layout as a point and the surface normal. */

@@ -14,6 +14,7 @@
 #include "light/light_sample.h"
 #include "material/bsdf.h"
 #include "util/vec3_convert.h"
+#include "zone/caustic.h"
 #include "zone/glint.h"
 
 #define MEDIA_MAX 8
@@ -50,9 +51,14 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         return lo <= 0 ? f3_to_v3(rs->sky) : v3(0, 0, 0);
     const rs_part *p = &rs->parts[h.part];
     vec3f xf = f3_madd(o, d, h.t);
+    /* Lights that send caustic photons (caustic.h) are theirs to count
+     * after a caustic target. */
+    int photons = (flags & ZR_CAUSTIC_LIGHT) &&
+                  (p->shape == SHAPE_TRIANGLE || p->shape == SHAPE_SPHERE);
     if (p->is_light)
-        return lo <= 0 && !(flags & ZR_NO_EMISSION) ? f3_to_v3(light_emitted(rs, p, xf, d))
-                                                     : v3(0, 0, 0);
+        return lo <= 0 && !(flags & ZR_NO_EMISSION) && !photons
+                   ? f3_to_v3(light_emitted(rs, p, xf, d))
+                   : v3(0, 0, 0);
     if (hi < 1)
         return v3(0, 0, 0);
 
@@ -106,8 +112,13 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
             k_refl += wt * fr;
             k_tran = wt * (1.0 - fr);
         }
+        /* Under ZR_NO_CAUSTIC every specular ray passes it on, and marks
+         * the rays that leave a caustic target. */
+        int cflags = 0;
+        if (flags & ZR_NO_CAUSTIC)
+            cflags = ZR_NO_CAUSTIC | (caustic_target(rs, h.part) ? ZR_CAUSTIC_LIGHT : 0);
         if (k_refl > 0) {
-            int rflags = exact_direct;
+            int rflags = exact_direct | cflags;
             if ((flags & ZR_NO_GLINT) && !back && media_count == 0 && glint_sphere(rs, h.part))
                 rflags |= ZR_NO_EMISSION;
             vec3 l = zone_radiance(t, out_o, refl, lo - 1, hi - 1, rflags, media, media_count);
@@ -129,7 +140,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                 nc--;
             }
             vec3 l = zone_radiance(t, ray_offset(xf, f3_neg(nf)), tr, lo - 1, hi - 1,
-                                   exact_direct, next, nc);
+                                   exact_direct | cflags, next, nc);
             out = v3_add(out, v3_scale(v3_mul(color, l), k_tran * eta * eta));
         }
     }

@@ -26,6 +26,7 @@ zone_quality zone_quality_for(const zt_scene *sc, int q)
     z.sides = 16 << (q / 2);
     z.aa = q < 3 ? 1 : 2;
     z.glint_cuts = 2 << (q / 2);
+    z.photons = 131072 << q;
     z.theta = 0.5 / step;
     /* Edge texels cut twice from quality 3: Cornell's level 3 at quality 4
      * went from 1.04% to 0.96% for 1.3x Phase One; at quality 2 it would
