@@ -121,7 +121,8 @@ static int mark_tips(p2_marks *m, const rscene *rs, const cam *c)
         if (!ok)
             return 0;
     }
-    qsort(m->tips, m->tip_count, sizeof *m->tips, cmp_u64);
+    if (m->tip_count > 1)
+        qsort(m->tips, m->tip_count, sizeof *m->tips, cmp_u64);
     return 1;
 }
 
@@ -176,6 +177,9 @@ void p2_marks_free(p2_marks *m)
 
 int p2_marks_tips(const p2_marks *m, size_t pixel, const uint64_t **tips)
 {
+    *tips = NULL;
+    if (m->tip_count == 0)
+        return 0;
     /* The first entry of the pixel, by bisection over the sorted keys. */
     size_t lo = 0, hi = m->tip_count;
     uint64_t key = (uint64_t)pixel << 32;
