@@ -4,6 +4,7 @@
  * receiver: directions over the ball's cone on a fine grid, each refracted
  * into and out of the ball and tested against the light triangle. */
 #include "test_support.h"
+#include "ray_triangle.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -36,16 +37,7 @@ static const vec3 centre = {0, 3, 0};
 
 static int hits_light(vec3 o, vec3 d)
 {
-    vec3 e1 = v3_sub(tri[1], tri[0]), e2 = v3_sub(tri[2], tri[0]);
-    vec3 p = v3_cross(d, e2);
-    double det = v3_dot(e1, p);
-    if (fabs(det) < 1e-14)
-        return 0;
-    vec3 s = v3_sub(o, tri[0]);
-    double u = v3_dot(s, p) / det;
-    vec3 q = v3_cross(s, e1);
-    double v = v3_dot(d, q) / det, t = v3_dot(e2, q) / det;
-    return u >= 0 && v >= 0 && u + v <= 1 && t > 0;
+    return ray_hits_triangle(o, d, tri);
 }
 
 static double fresnel(double ci, double n1, double n2)

@@ -3,6 +3,7 @@
  * on a fine grid, each reflected off the sphere and tested against the
  * light triangle. */
 #include "test_support.h"
+#include "ray_triangle.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -25,19 +26,9 @@ static const char *scene_text =
 
 static vec3 tri[3] = {{-0.6, 3, -0.5}, {0.7, 3, -0.4}, {0, 3, 0.8}};
 
-/* Whether the ray (o, d) meets the light triangle (either side). */
 static int hits_light(vec3 o, vec3 d)
 {
-    vec3 e1 = v3_sub(tri[1], tri[0]), e2 = v3_sub(tri[2], tri[0]);
-    vec3 p = v3_cross(d, e2);
-    double det = v3_dot(e1, p);
-    if (fabs(det) < 1e-14)
-        return 0;
-    vec3 s = v3_sub(o, tri[0]);
-    double u = v3_dot(s, p) / det;
-    vec3 q = v3_cross(s, e1);
-    double v = v3_dot(d, q) / det, t = v3_dot(e2, q) / det;
-    return u >= 0 && v >= 0 && u + v <= 1 && t > 0;
+    return ray_hits_triangle(o, d, tri);
 }
 
 /* Irradiance at x (normal n) of the light (unit radiance) seen in the unit

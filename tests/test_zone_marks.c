@@ -4,6 +4,7 @@
  * sphere.  Both against values computed here from the geometry alone;
  * and a pixel whose fine grid holds many surfaces. */
 #include "test_support.h"
+#include "ray_triangle.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -63,31 +64,7 @@ static void test_light_between_rays(void **state)
     zt_image_release(img);
 }
 
-static const double tri[3][3] = {{2.8, -0.2, 2.8}, {3.3, 0.0, 3.0}, {3.0, 0.3, 3.3}};
-
-/* Whether the ray (o, d) meets the light triangle. */
-static int hits_light(const double o[3], const double d[3])
-{
-    double e1[3], e2[3], p[3], s[3], q[3];
-    for (int i = 0; i < 3; i++) {
-        e1[i] = tri[1][i] - tri[0][i];
-        e2[i] = tri[2][i] - tri[0][i];
-        s[i] = o[i] - tri[0][i];
-    }
-    p[0] = d[1] * e2[2] - d[2] * e2[1];
-    p[1] = d[2] * e2[0] - d[0] * e2[2];
-    p[2] = d[0] * e2[1] - d[1] * e2[0];
-    double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
-    if (fabs(det) < 1e-14)
-        return 0;
-    double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
-    q[0] = s[1] * e1[2] - s[2] * e1[1];
-    q[1] = s[2] * e1[0] - s[0] * e1[2];
-    q[2] = s[0] * e1[1] - s[1] * e1[0];
-    double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
-    double t = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
-    return u >= 0 && v >= 0 && u + v <= 1 && t > 0;
-}
+static const vec3 tri[3] = {{2.8, -0.2, 2.8}, {3.3, 0.0, 3.0}, {3.0, 0.3, 3.3}};
 
 /* The screen area whose rays reflect off the unit sphere at the origin
  * into the light: midpoint rule on an n x n grid over the square
@@ -95,25 +72,17 @@ static int hits_light(const double o[3], const double d[3])
  * 1/sqrt(99) there). */
 static double image_area(int n)
 {
-    const double eye[3] = {0, 0, 10};
+    const vec3 eye = {0, 0, 10};
     long count = 0;
     for (int j = 0; j < n; j++)
         for (int i = 0; i < n; i++) {
-            double d[3] = {0.11 * (-1 + 2 * (i + 0.5) / n), 0.11 * (1 - 2 * (j + 0.5) / n), -1};
-            double l = sqrt(d[0] * d[0] + d[1] * d[1] + 1);
-            for (int k = 0; k < 3; k++)
-                d[k] /= l;
-            double b = eye[0] * d[0] + eye[1] * d[1] + eye[2] * d[2];
-            double disc = b * b - (100 - 1);
+            vec3 d = v3_normalize(v3(0.11 * (-1 + 2 * (i + 0.5) / n), 0.11 * (1 - 2 * (j + 0.5) / n), -1));
+            double b = v3_dot(eye, d), disc = b * b - (100 - 1);
             if (disc <= 0)
                 continue;
-            double t = -b - sqrt(disc), p[3], r[3];
-            for (int k = 0; k < 3; k++)
-                p[k] = eye[k] + t * d[k];
-            double dp = d[0] * p[0] + d[1] * p[1] + d[2] * p[2];
-            for (int k = 0; k < 3; k++)
-                r[k] = d[k] - 2 * dp * p[k];
-            count += hits_light(p, r);
+            vec3 p = v3_add(eye, v3_scale(d, -b - sqrt(disc)));
+            vec3 r = v3_sub(d, v3_scale(p, 2 * v3_dot(d, p)));
+            count += ray_hits_triangle(p, r, tri);
         }
     return count * (0.22 * 0.22 / ((double)n * n));
 }

@@ -10,10 +10,10 @@
 #include "material/bsdf.h"
 #include "util/error.h"
 #include "util/vec3_convert.h"
+#include "zone/media.h"
 #include "zone/glint.h"
 
 #define PI_D 3.14159265358979323846
-#define MEDIA_MAX 8
 #define CHUNK 1024        /* photons per work item */
 #define MIN_PHOTONS 256   /* per (light, target): a small target still gets a few */
 #define DETAIL_SUB 4      /* fine cells per texel side where a caustic is
@@ -234,19 +234,9 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, vec3 dflux, double sh
     }
     if (k_tran > 0 && share * k_tran * cmax >= BRANCH_MIN) {
         float eta = eta_i / eta_t;
-        float sin2 = eta * eta * (1.0f - cos_o * cos_o);
-        float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2));
-        vec3f tr = f3_normalize(f3_sub(f3_scale(d, eta), f3_scale(nf, cos_t - eta * cos_o)));
+        vec3f tr = media_refract(d, nf, cos_o, eta);
         int next[MEDIA_MAX];
-        int nc = media_count;
-        for (int i = 0; i < nc && i < MEDIA_MAX; i++)
-            next[i] = media[i];
-        if (entering) {
-            if (nc < MEDIA_MAX)
-                next[nc++] = p->object;
-        } else {
-            nc--;
-        }
+        int nc = media_cross(media, media_count, p->object, entering, next);
         /* Flux crosses the surface less what it reflects: no eta^2 here.
          * The radiance convention's eta^2 (zone_radiance) is what radiance
          * gains as flux is squeezed into a smaller solid angle; a photon

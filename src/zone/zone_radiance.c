@@ -14,10 +14,10 @@
 #include "light/light_sample.h"
 #include "material/bsdf.h"
 #include "util/vec3_convert.h"
+#include "zone/media.h"
 #include "zone/caustic.h"
 #include "zone/glint.h"
 
-#define MEDIA_MAX 8
 
 
 static vec3 direct_light(zone_trace *t, int receiver, vec3 x, vec3 n)
@@ -126,19 +126,9 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         }
         if (k_tran > 0) {
             float eta = eta_i / eta_t;
-            float sin2 = eta * eta * (1.0f - cos_o * cos_o);
-            float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2));
-            vec3f tr = f3_normalize(f3_sub(f3_scale(d, eta), f3_scale(nf, cos_t - eta * cos_o)));
+            vec3f tr = media_refract(d, nf, cos_o, eta);
             int next[MEDIA_MAX];
-            int nc = media_count;
-            for (int i = 0; i < nc && i < MEDIA_MAX; i++)
-                next[i] = media[i];
-            if (entering) {
-                if (nc < MEDIA_MAX)
-                    next[nc++] = p->object;
-            } else {
-                nc--;
-            }
+            int nc = media_cross(media, media_count, p->object, entering, next);
             vec3 l = zone_radiance(t, ray_offset(xf, f3_neg(nf)), tr, lo - 1, hi - 1,
                                    exact_direct | cflags, next, nc);
             out = v3_add(out, v3_scale(v3_mul(color, l), k_tran * eta * eta));
