@@ -1017,6 +1017,12 @@ static void main_loop(viewer *v)
         run_script(v, now);
         report(v, now);
     }
+    /* A script may press 'p' and quit in one step (when a screenshot
+     * before them waited for samples): the shot is still taken. */
+    if (v->screenshot_pending) {
+        v->screenshot_pending = 0;
+        screenshot_key(v);
+    }
 }
 
 int cli_view(int argc, char **argv)
