@@ -336,11 +336,33 @@ static void shoot(tracer *t, const pair *pr, int i)
            NULL, 0);
 }
 
-/* Photons per pair: the light's budget shared by how much of its light
+/* Whether light part li sends photons. */
+static int sends_photons(const zt_scene *sc, const rs_part *lp)
+{
+    return lp->is_light && (lp->shape == SHAPE_TRIANGLE || lp->shape == SHAPE_SPHERE) &&
+           v3_max(sc->objects[lp->object].emission) > 0;
+}
+
+/* Photons per pair: each light's budget shared by how much of its light
  * each target can catch (solid angle from the light's centre x specular
- * weight x colour), at least MIN_PHOTONS. */
+ * weight x colour), at least MIN_PHOTONS.  A light's budget is q.photons
+ * for up to LIGHTS_FULL lights; past that, LIGHTS_FULL budgets are shared
+ * among them all, and the floor drops to FLOOR_MANY when the pairs would
+ * take more than the total: a mesh light of thousands of triangles must
+ * not take thousands of times the photons. */
+#define LIGHTS_FULL 8
+#define FLOOR_MANY 16
 static int make_pairs(const zone_forest *f, const zt_scene *sc, const rscene *rs, pair **out)
 {
+    int lights = 0;
+    for (int li = 0; li < rs->part_count; li++)
+        lights += sends_photons(sc, &rs->parts[li]);
+    int targets = 0;
+    for (int i = 0; i < rs->part_count; i++)
+        targets += caustic_target(rs, i);
+    double total_budget = (double)f->q.photons * (lights < LIGHTS_FULL ? lights : LIGHTS_FULL);
+    double light_budget = lights ? total_budget / lights : 0;
+    int floor_n = (double)lights * targets * MIN_PHOTONS <= total_budget ? MIN_PHOTONS : FLOOR_MANY;
     int cap = 16, count = 0;
     pair *ps = malloc((size_t)cap * sizeof *ps);
     double *imp = malloc((size_t)(rs->part_count + 1) * sizeof *imp);
@@ -352,8 +374,7 @@ static int make_pairs(const zone_forest *f, const zt_scene *sc, const rscene *rs
     for (int li = 0; li < rs->part_count; li++) {
         const rs_part *lp = &rs->parts[li];
         vec3 em = sc->objects[lp->object].emission;
-        if (!lp->is_light || (lp->shape != SHAPE_TRIANGLE && lp->shape != SHAPE_SPHERE) ||
-            !(v3_max(em) > 0))
+        if (!sends_photons(sc, lp))
             continue;
         vec3 cl, ct;
         double rl, rt, total = 0;
@@ -386,8 +407,8 @@ static int make_pairs(const zone_forest *f, const zt_scene *sc, const rscene *rs
                 }
                 ps = np;
             }
-            double share = (double)f->q.photons * imp[i] / total;
-            int n = share < MIN_PHOTONS ? MIN_PHOTONS : (int)(share + 0.5);
+            double share = light_budget * imp[i] / total;
+            int n = share < floor_n ? floor_n : (int)(share + 0.5);
             ps[count++] = (pair){li, i, n, em};
         }
     }
