@@ -17,6 +17,7 @@
 #include "geom/accel.h"
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
+#include "zone/media.h"
 #include "zone/phase_two.h"
 
 #define FINE_GRID 64   /* the grid where a light is seen by way of a mirror */
@@ -102,8 +103,7 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
                 if (glint)
                     *glint = 1;
             }
-            float cos_t = sqrtf(1.0f - sin2_t);
-            d = f3_normalize(f3_sub(f3_scale(d, eta), f3_scale(n, cos_t - eta * cos_o)));
+            d = media_refract(d, n, cos_o, eta);
             o = ray_offset(x, f3_neg(n));
             inside = leaving ? -1 : p->object;
         } else {
@@ -328,8 +328,8 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
     if (!*scratch && !(*scratch = malloc(sizeof(edge_grid))))
         return 0;
     int glint = 0, rim = 0;
-    if (!edge_samples(c, px, py, c->f->q.edge_grid, c->f->q.edge_shade, *scratch, lights, row, rays, &glint,
-                      &rim, 0))
+    if (!edge_samples(c, px, py, c->f->q.edge_grid, c->f->q.edge_shade, *scratch, lights, row,
+                      rays, &glint, &rim, 0))
         return 0;
     if (glint || rim || marked) {
         /* A light seen in a mirror or through glass: its image is the
