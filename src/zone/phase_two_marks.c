@@ -6,9 +6,9 @@
  * there, it gets its exact level-0 coverage like any light seen.
  *
  * Fine pixels: where a light's image in a mirror, metal or glass sphere
- * falls.  Such an image can
- * be smaller than a pixel's corner and sample spacing, so no signature finds
- * it and the pixel is shaded as smooth, without the light.  Each light's
+ * falls.  Such an image can be smaller than a pixel's corner and sample
+ * spacing, so no signature finds it and the pixel is shaded as smooth,
+ * without the light.  Each light's
  * points are carried to their specular points on the sphere for the
  * viewpoint (as glint.c does for texels) and projected onto the screen; the
  * pixels under the box they span, one pixel wider each way, take the fine
@@ -74,8 +74,10 @@ static void mark_box(const cam *c, const box *b, unsigned char *mark)
      * roughly, and a pixel's corner signatures see a little beyond it. */
     double x0 = fmax(b->x0 - 1.0, 0.0), y0 = fmax(b->y0 - 1.0, 0.0);
     double x1 = fmin(b->x1 + 1.0, c->width - 1.0), y1 = fmin(b->y1 + 1.0, c->height - 1.0);
-    for (int y = (int)y0; y <= (int)y1 && y0 <= y1; y++)
-        for (int x = (int)x0; x <= (int)x1 && x0 <= x1; x++)
+    if (!(x0 <= x1 && y0 <= y1))
+        return; /* off screen: nothing to convert to pixel indices */
+    for (int y = (int)y0; y <= (int)y1; y++)
+        for (int x = (int)x0; x <= (int)x1; x++)
             mark[(size_t)y * c->width + x] = 1;
 }
 
@@ -84,8 +86,8 @@ static void mark_box(const cam *c, const box *b, unsigned char *mark)
 static int add_tip(p2_marks *m, const cam *c, vec3 w, int part)
 {
     double px, py;
-    if (!project(c, w, &px, &py) || px < 0 || py < 0 || px >= c->width || py >= c->height)
-        return 1;
+    if (!project(c, w, &px, &py) || !(px >= 0 && py >= 0 && px < c->width && py < c->height))
+        return 1; /* off screen (or not a number) */
     if (m->tip_count == m->tip_capacity) {
         size_t cap = m->tip_capacity ? 2 * m->tip_capacity : 16;
         uint64_t *nt = realloc(m->tips, cap * sizeof *nt);
