@@ -449,13 +449,7 @@ static double cell_area(const part_map *m, int i, int j, int su, int sv)
     if (m->cover[(size_t)j * l->nu + i] >= 1.0f)
         return whole;
     vec3 q[2 * MAP_CLIPS + 8];
-    q[0] = map_point(l, a0, b0);
-    q[1] = map_point(l, a1, b0);
-    q[2] = map_point(l, a1, b1);
-    q[3] = map_point(l, a0, b1);
-    int n = 4;
-    for (int k = 0; k < l->clips && n >= 3; k++)
-        n = poly3_clip(q, n, 2 * MAP_CLIPS + 8, l->clip_n[k], l->clip_d[k]);
+    int n = map_rect_polygon(l, a0, a1, b0, b1, q, 2 * MAP_CLIPS + 8);
     vec3 sum = v3(0, 0, 0);
     for (int k = 1; k + 1 < n; k++)
         sum = v3_add(sum, v3_cross(v3_sub(q[k], q[0]), v3_sub(q[k + 1], q[0])));

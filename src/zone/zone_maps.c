@@ -151,8 +151,13 @@ int poly3_clip(vec3 *q, int n, int max, vec3 a, double b)
 
 int map_texel_polygon(const map_layout *l, int i, int j, vec3 *q, int max)
 {
-    double s0 = axis_edge(&l->au, i), s1 = axis_edge(&l->au, i + 1);
-    double t0 = axis_edge(&l->av, j), t1 = axis_edge(&l->av, j + 1);
+    return map_rect_polygon(l, axis_edge(&l->au, i), axis_edge(&l->au, i + 1),
+                            axis_edge(&l->av, j), axis_edge(&l->av, j + 1), q, max);
+}
+
+int map_rect_polygon(const map_layout *l, double s0, double s1, double t0, double t1, vec3 *q,
+                     int max)
+{
     q[0] = map_point(l, s0, t0);
     q[1] = map_point(l, s1, t0);
     q[2] = map_point(l, s1, t1);

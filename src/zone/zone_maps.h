@@ -147,6 +147,9 @@ vec3 map_point(const map_layout *l, double s, double t);
 /* Texel (i, j) of a planar layout as a polygon (4 corners, then clipped to
  * the surface); returns the corner count, under 3 when nothing is left. */
 int map_texel_polygon(const map_layout *l, int i, int j, vec3 *q, int max);
+/* The same for the rectangle [s0, s1] x [t0, t1] of a planar layout. */
+int map_rect_polygon(const map_layout *l, double s0, double s1, double t0, double t1, vec3 *q,
+                     int max);
 
 /* Keeps the part of polygon q (n corners, room for max) where
  * a . p + b >= 0; returns the new corner count. */
