@@ -219,6 +219,26 @@ static void test_terms_sum_to_shading(void **state)
     check_terms(sky_box_text, 2);
 }
 
+/* The images of levels 0..o.depth, rendered one by one, add up to `all`
+ * (the depth image); each level but those below first_lit must be lit. */
+static void assert_levels_sum(const zt_scene *s, zt_render_options o, const zt_image *all,
+                              int first_lit, const char *what)
+{
+    zt_image *sum = zt_image_create(W, H);
+    for (int l = 0; l <= o.depth; l++) {
+        o.level = l;
+        zt_image *li = render(s, &o, NULL);
+        assert_true(l < first_lit || image_mean(li) > 0);
+        for (size_t i = 0; i < floats(sum); i++)
+            sum->pixels[i] += li->pixels[i];
+        zt_image_release(li);
+    }
+    double e = rel_rmse(sum, all);
+    if (!(e < 1e-5))
+        fail_msg("%s 0..%d vs depth %d: rel_rmse %g", what, o.depth, o.depth, e);
+    zt_image_release(sum);
+}
+
 static void test_levels_sum_to_depth(void **state)
 {
     (void)state;
@@ -226,19 +246,7 @@ static void test_levels_sum_to_depth(void **state)
     const int depth = 3;
     zt_render_options o = zone_options(depth, 2);
     zt_image *all = render(s, &o, NULL);
-    zt_image *sum = zt_image_create(W, H);
-    for (int l = 0; l <= depth; l++) {
-        o.level = l;
-        zt_image *li = render(s, &o, NULL);
-        assert_true(l == 0 || image_mean(li) > 0);
-        for (size_t i = 0; i < floats(sum); i++)
-            sum->pixels[i] += li->pixels[i];
-        zt_image_release(li);
-    }
-    double e = rel_rmse(sum, all);
-    if (!(e < 1e-5))
-        fail_msg("levels 0..%d vs depth %d: rel_rmse %g", depth, depth, e);
-    zt_image_release(sum);
+    assert_levels_sum(s, o, all, 1, "levels");
     zt_image_release(all);
     zt_scene_release(s);
 }
@@ -272,19 +280,7 @@ static void test_crossings(void **state)
     zt_image *loaded = render(s, &lo, NULL);
     assert_same_bytes(all, loaded, "crossings: built vs loaded forest");
     zt_image_release(loaded);
-    zt_image *sum = zt_image_create(W, H);
-    for (int l = 0; l <= depth; l++) {
-        o.level = l;
-        zt_image *li = render(s, &o, NULL);
-        assert_true(image_mean(li) > 0);
-        for (size_t i = 0; i < floats(sum); i++)
-            sum->pixels[i] += li->pixels[i];
-        zt_image_release(li);
-    }
-    double e = rel_rmse(sum, all);
-    if (!(e < 1e-5))
-        fail_msg("crossings: levels 0..%d vs depth %d: rel_rmse %g", depth, depth, e);
-    zt_image_release(sum);
+    assert_levels_sum(s, o, all, 0, "crossings: levels");
     zt_image_release(all);
     zt_renderer_release(r);
     zt_scene_release(s);
