@@ -241,6 +241,7 @@ typedef struct source {
     int index, level, side;
     int background;    /* its flag, for visibility rays */
     vec3 scale;        /* w_d * rho / pi: radiance per irradiance */
+    int pierced;       /* the receiver's surface pierces it (a crossing) */
 } source;
 
 typedef struct receiver {
@@ -348,7 +349,7 @@ static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, 
      * pierces the source, the part of the source in front of it is lit
      * differently from the part behind: such pieces go down to texels, and
      * a texel the crossing cuts gives the light of its half in front. */
-    if (n >= 3 && crossing_of(src->m, r->part) >= 0) {
+    if (n >= 3 && src->pierced) {
         int behind = 0, front = 0;
         for (int k = 0; k < n; k++) {
             double h = v3_dot(r->n, v3_sub(q[k], r->x));
@@ -392,7 +393,8 @@ vec3 transfer_irradiance(zone_trace *t, int receiver_part, vec3 x, vec3 n, int l
         if (side >= m->layout.sides || side_dist == 0)
             continue;
         source src = {m, i, level - 1, side, o->background,
-                      v3_scale(o->mat.color, o->mat.weight[LOBE_DIFFUSE] / 3.14159265358979)};
+                      v3_scale(o->mat.color, o->mat.weight[LOBE_DIFFUSE] / 3.14159265358979),
+                      crossing_of(m, receiver_part) >= 0};
         e = v3_add(e, piece(&r, &src, 0, 0, m->layout.nu, m->layout.nv));
     }
     return e;
