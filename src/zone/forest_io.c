@@ -694,8 +694,8 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
         int details = r_i32(rb);
         if (rb->short_read)
             return ZT_ERR_PARSE;
-        if (details < 0 || details > 2 * f->map_levels || (details && l->shape == SHAPE_SPHERE))
-            return corrupt(err, path, "bad caustic window count");
+        if (details < 0 || details > 4 * f->map_levels || (details && l->shape == SHAPE_SPHERE))
+            return corrupt(err, path, "bad detail window count");
         m->detail = calloc((size_t)details + 1, sizeof(map_detail));
         if (!m->detail)
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
@@ -714,7 +714,7 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
             if (d->level < 1 || d->level >= f->map_levels || d->side < 0 || d->side >= l->sides ||
                 d->i0 < 0 || d->ni < 1 || d->ni > l->nu - d->i0 || d->j0 < 0 || d->nj < 1 ||
                 d->nj > l->nv - d->j0 || d->sub < 1 || d->sub > 64)
-                return corrupt(err, path, "bad caustic window");
+                return corrupt(err, path, "bad detail window");
             size_t nuse = (size_t)d->ni * d->nj;
             if (nuse > rb->n - rb->at) {
                 rb->short_read = 1;
@@ -726,7 +726,7 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
             for (size_t k2 = 0; k2 < nuse; k2++) {
                 d->use[k2] = rb->b[rb->at++];
                 if (d->use[k2] > 1)
-                    return corrupt(err, path, "bad caustic window");
+                    return corrupt(err, path, "bad detail window");
             }
             d->e = r_f32s(rb, detail_values(d), &oom);
             if (d->e)

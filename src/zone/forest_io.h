@@ -7,7 +7,7 @@
 
 #include "zone/zone_internal.h"
 
-#define FOREST_FILE_VERSION 6
+#define FOREST_FILE_VERSION 7
 
 /* Writes f (the forest of renderer r) to path, through a temporary file
  * renamed into place. */

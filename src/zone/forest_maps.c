@@ -15,6 +15,7 @@
 #include "zone/caustic.h"
 #include "zone/glint.h"
 #include "zone/map_layout.h"
+#include "zone/refine.h"
 #include "zone/transfer.h"
 #include "zone/zone_internal.h"
 
@@ -481,7 +482,7 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
         }
     }
     f->rays += rays;
-    if (!caustic_finish(f))
+    if (!caustic_finish(f) || !refine_build(f, r))
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
     /* What only the transfer needed goes: Phase Two reads texels, weights
      * and their coarser copies, as a forest read from a file does. */

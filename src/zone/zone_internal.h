@@ -49,6 +49,10 @@ typedef struct zone_quality {
     int probe;          /* signatures per side that look for an edge in a
                            pixel (no more than aa: the samples' own) */
     int photons;        /* caustic photons per light (caustic.h) */
+    int refine_sub;     /* fine cells per texel side where a map is refined
+                           (refine.h; 0: none) */
+    double refine_contrast; /* texels refined where a neighbour differs by
+                               more than this share */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;
