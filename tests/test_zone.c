@@ -261,8 +261,10 @@ static const char *cross_text =
     DIFFUSE(0.8, 0.5, 0.3) "}},"
     "{\"triangle\": {\"points\": [[-4, 3, -4], [4, -3, -4], [0, 0.5, 4]], \"material\": "
     DIFFUSE(0.3, 0.6, 0.8) "}}"
-    "], \"camera\": {\"viewpoint\": [0.5, 0.3, 12], \"screen\": [[-1, 1, 11], "
-    "[1, 1, 11], [-1, -1, 11], [1, -1, 11]], \"gridresolution\": [20, 16]}}";
+    /* from the side, as the triangles' planes nearly hold the z axis */
+    "], \"camera\": {\"viewpoint\": [6, 5, 9], \"screen\": [[4.9109, 5.0797, 8.3578], "
+    "[5.8261, 5.0797, 7.7476], [5.1669, 4.0812, 8.7418], [6.0821, 4.0812, 8.1317]], "
+    "\"gridresolution\": [20, 16]}}";
 
 static void test_crossings(void **state)
 {
