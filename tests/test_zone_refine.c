@@ -135,7 +135,7 @@ static void test_refined_read_follows_crossing(void **state)
 }
 
 /* The refinement is part of the forest: an image from a saved and loaded
- * forest is the same, byte for byte. */
+ * forest is the same, byte for byte, and so is one made on one thread. */
 static void test_refined_forest_round_trip(void **state)
 {
     (void)state;
@@ -150,8 +150,11 @@ static void test_refined_forest_round_trip(void **state)
     zt_renderer *r = make(s, 5);
     const char *path = test_tmp_path("refine.forest");
     assert_int_equal(zt_renderer_save_forest(r, path, &err), ZT_OK);
-    zt_image *built = NULL, *loaded = NULL;
+    zt_image *built = NULL, *loaded = NULL, *one = NULL;
+    o.threads = 2;
     assert_int_equal(zt_render(s, &o, &built, NULL, &err), ZT_OK);
+    o.threads = 1; /* and the fine cells do not depend on the thread count */
+    assert_int_equal(zt_render(s, &o, &one, NULL, &err), ZT_OK);
     o.forest_file = path;
     assert_int_equal(zt_render(s, &o, &loaded, NULL, &err), ZT_OK);
     assert_true(built->width == loaded->width && built->height == loaded->height);
@@ -161,8 +164,10 @@ static void test_refined_forest_round_trip(void **state)
         sum += built->pixels[i];
     assert_true(sum > 0);
     assert_memory_equal(built->pixels, loaded->pixels, n * sizeof *built->pixels);
+    assert_memory_equal(built->pixels, one->pixels, n * sizeof *built->pixels);
     zt_image_release(built);
     zt_image_release(loaded);
+    zt_image_release(one);
     zt_renderer_release(r);
     zt_scene_release(s);
 }
