@@ -61,14 +61,7 @@ static const char *other_box_text = BOX_SCENE("", DIFFUSE(0.6, 0.6, 0.5));
 static const char *sky_box_text =
     BOX_SCENE("{\"sky\": {\"color\": [0.3, 0.4, 0.6]}},", DIFFUSE(0.6, 0.6, 0.6));
 
-static zt_scene *scene_from(const char *text)
-{
-    zt_scene *s = NULL;
-    zt_error err = {0};
-    if (zt_scene_load_string(text, strlen(text), "box.json", &s, &err) != ZT_OK)
-        fail_msg("scene does not load: %s", err.message);
-    return s;
-}
+static zt_scene *scene_from(const char *text) { return test_scene_text(text, "box.json"); }
 
 static zt_render_options zone_options(int depth, int threads)
 {

@@ -104,25 +104,10 @@ static double numeric(vec3 x, int steps)
 
 static zt_renderer *make(zt_scene *s, int threads, int quality)
 {
-    zt_render_options o = zt_render_options_default();
-    o.method = ZT_METHOD_ZONE;
-    o.depth = 3;
-    o.threads = threads;
-    o.quality = quality;
-    zt_renderer *r = NULL;
-    zt_error err = {0};
-    assert_int_equal(zt_renderer_create(s, &o, &r, &err), ZT_OK);
-    return r;
+    return test_zone_renderer(s, 3, threads, quality);
 }
 
-static zt_scene *load(void)
-{
-    zt_scene *s = NULL;
-    zt_error err = {0};
-    assert_int_equal(zt_scene_load_string(scene_text, strlen(scene_text), "caustic.json", &s, &err),
-                     ZT_OK);
-    return s;
-}
+static zt_scene *load(void) { return test_scene_text(scene_text, "caustic.json"); }
 
 /* The floor's level-2 map along a line through the caustic's cusp (under
  * the ball's centre) matches the integral, and comes closer there as the

@@ -80,16 +80,10 @@ static double numeric(vec3 x, int n)
 
 static zt_renderer *make(const zt_scene *s, int quality)
 {
-    zt_render_options o = zt_render_options_default();
-    o.method = ZT_METHOD_ZONE;
-    o.depth = 2;
-    o.threads = 2;
-    o.quality = quality;
-    zt_renderer *r = NULL;
-    zt_error err = {0};
-    assert_int_equal(zt_renderer_create(s, &o, &r, &err), ZT_OK);
-    return r;
+    return test_zone_renderer(s, 2, 2, quality);
 }
+
+static zt_scene *load(void) { return test_scene_text(scene_text, "refine.json"); }
 
 static double map_read(const zt_renderer *r, vec3 x)
 {
@@ -102,10 +96,7 @@ static double map_read(const zt_renderer *r, vec3 x)
 static void test_refined_read_follows_crossing(void **state)
 {
     (void)state;
-    zt_scene *s = NULL;
-    zt_error err = {0};
-    assert_int_equal(
-        zt_scene_load_string(scene_text, strlen(scene_text), "refine.json", &s, &err), ZT_OK);
+    zt_scene *s = load();
     zt_renderer *plain = make(s, 4), *refined = make(s, 5);
     assert_int_equal(plain->forest->q.refine_sub, 0);
     assert_true(refined->forest->q.refine_sub > 0);
@@ -139,10 +130,8 @@ static void test_refined_read_follows_crossing(void **state)
 static void test_refined_forest_round_trip(void **state)
 {
     (void)state;
-    zt_scene *s = NULL;
+    zt_scene *s = load();
     zt_error err = {0};
-    assert_int_equal(
-        zt_scene_load_string(scene_text, strlen(scene_text), "refine.json", &s, &err), ZT_OK);
     zt_render_options o = zt_render_options_default();
     o.method = ZT_METHOD_ZONE;
     o.depth = 2;

@@ -98,3 +98,26 @@ int test_run_cli(const char *args, char **err_out)
         return -1;
     return WEXITSTATUS(status);
 }
+
+zt_scene *test_scene_text(const char *text, const char *name)
+{
+    zt_scene *s = NULL;
+    zt_error err = {0};
+    if (zt_scene_load_string(text, strlen(text), name, &s, &err) != ZT_OK)
+        fail_msg("scene does not load: %s", err.message);
+    return s;
+}
+
+zt_renderer *test_zone_renderer(const zt_scene *s, int depth, int threads, int quality)
+{
+    zt_render_options o = zt_render_options_default();
+    o.method = ZT_METHOD_ZONE;
+    o.depth = depth;
+    o.threads = threads;
+    o.quality = quality;
+    zt_renderer *r = NULL;
+    zt_error err = {0};
+    if (zt_renderer_create(s, &o, &r, &err) != ZT_OK)
+        fail_msg("zone renderer: %s", err.message);
+    return r;
+}

@@ -9,6 +9,9 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "zonetrace/render.h"
+#include "zonetrace/scene.h"
+
 /* The ../shared folder beside the clone, or NULL (with a message on stderr
  * saying the test is skipped) when it is absent. */
 const char *test_shared_dir(void);
@@ -29,5 +32,12 @@ int test_run_cli(const char *args, char **err_out);
 
 /* Reads a whole file (malloc'd, NUL-terminated) or NULL. */
 char *test_read_file(const char *path, size_t *length);
+
+/* A scene from JSON text (named `name` in messages); fails the test when
+ * it does not load. */
+zt_scene *test_scene_text(const char *text, const char *name);
+
+/* A zone renderer (Phase One done) for the scene; fails the test on error. */
+zt_renderer *test_zone_renderer(const zt_scene *s, int depth, int threads, int quality);
 
 #endif
