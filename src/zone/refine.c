@@ -13,8 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "zone/refine.h"
 #include "render/render_internal.h"
+#include "zone/refine.h"
 #include "zone/transfer.h"
 
 /* Luminance-like weight, only to compare texels. */
@@ -41,9 +41,9 @@ static int mark_rough(const part_map *m, int level, int side, double contrast,
                 continue;
             int rough = m->crossings && m->cut[k] >= 0;
             double a = texel_level(v + 3 * k);
-            static const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+            static const int step_i[4] = {1, -1, 0, 0}, step_j[4] = {0, 0, 1, -1};
             for (int q = 0; q < 4 && !rough; q++) {
-                int i2 = i + di[q], j2 = j + dj[q];
+                int i2 = i + step_i[q], j2 = j + step_j[q];
                 if (i2 < 0 || j2 < 0 || i2 >= nu || j2 >= nv)
                     continue;
                 size_t k2 = (size_t)j2 * nu + i2;
@@ -134,8 +134,8 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
             vec3 x, n;
             cell_point(l, i, j, su, sv, sub, side, &x, &n);
             /* Twice the texels' piece size: at quality 4, triangletest's
-             * level 2 was 3.85% with theta, 3.96% with 2 theta, in half the
-             * time (5.58% unrefined). */
+             * level 2 was 3.84% with theta, 3.94% with 2 theta, in half the
+             * time (5.56% unrefined). */
             vec3 exact = transfer_irradiance(&t, part, x, n, level, 2.0 * f->q.theta);
             vec3 read = map_lookup_wide(m, level, side, x, 0.0);
             float *e = d->e + 3 * ((size_t)b * fu + a);
@@ -156,7 +156,7 @@ int refine_build(zone_forest *f, const zt_renderer *r)
     uint64_t rays = 0;
     for (int p = 0; p < f->map_count; p++) {
         part_map *m = &f->maps[p];
-        if (!m->texels || m->layout.shape == SHAPE_SPHERE || m->details)
+        if (!m->texels || m->layout.shape == SHAPE_SPHERE)
             continue;
         const map_layout *l = &m->layout;
         unsigned char *mark = malloc((size_t)l->nu * l->nv);
