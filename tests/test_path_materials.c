@@ -6,6 +6,7 @@
  * Z_MEAN standard errors estimated from the spread of the pixels, exact
  * estimates within float rounding. */
 #include "test_support.h"
+#include "fresnel.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -22,19 +23,6 @@
 /* ---------------------------------------------------------------------
  * Closed forms and cameras.
  * --------------------------------------------------------------------- */
-
-/* Unpolarised Fresnel reflectance from index n1 into n2 (1 under total
- * internal reflection). */
-static double fresnel(double cos_i, double n1, double n2)
-{
-    double sin2_t = (n1 / n2) * (n1 / n2) * (1 - cos_i * cos_i);
-    if (sin2_t >= 1)
-        return 1;
-    double cos_t = sqrt(1 - sin2_t);
-    double rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
-    double rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
-    return 0.5 * (rs * rs + rp * rp);
-}
 
 static double schlick(double cos_i, double n)
 {

@@ -4,6 +4,7 @@
  * receiver: directions over the ball's cone on a fine grid, each refracted
  * into and out of the ball and tested against the light triangle. */
 #include "test_support.h"
+#include "fresnel.h"
 #include "ray_triangle.h"
 
 #include <math.h>
@@ -38,17 +39,6 @@ static const vec3 centre = {0, 3, 0};
 static int hits_light(vec3 o, vec3 d)
 {
     return ray_hits_triangle(o, d, tri);
-}
-
-static double fresnel(double ci, double n1, double n2)
-{
-    double s2 = (n1 / n2) * (n1 / n2) * (1 - ci * ci);
-    if (s2 >= 1)
-        return 1;
-    double ct = sqrt(1 - s2);
-    double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
-    double rp = (n1 * ct - n2 * ci) / (n1 * ct + n2 * ci);
-    return 0.5 * (rs * rs + rp * rp);
 }
 
 /* Refracts unit d at unit normal n (facing d's origin side), n1 -> n2;

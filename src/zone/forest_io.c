@@ -369,7 +369,9 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
             w_i32(&w, d->sub);
             w_bytes(&w, d->use, (size_t)d->ni * d->nj);
             w_f32s(&w, d->e, detail_values(d));
-            w_f32s(&w, d->coarse, (size_t)l->nu * l->nv * 3);
+            /* A window with nothing outside its marks writes zeros there. */
+            for (size_t k2 = 0; k2 < (size_t)l->nu * l->nv * 3; k2++)
+                w_f32(&w, d->coarse ? d->coarse[k2] : 0.0f);
         }
     }
     /* File size and checksum. */
@@ -497,6 +499,14 @@ static vec3 r_v3(rbuf *r)
 }
 
 /* n floats into a new array, or NULL (short read or no memory: *oom). */
+static int all_zero(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (v[i] != 0.0f)
+            return 0;
+    return 1;
+}
+
 static float *r_f32s(rbuf *r, size_t n, int *oom)
 {
     if (r->short_read || n > (r->n - r->at) / 4) {
@@ -731,6 +741,10 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
             d->e = r_f32s(rb, detail_values(d), &oom);
             if (d->e)
                 d->coarse = r_f32s(rb, (size_t)l->nu * l->nv * 3, &oom);
+            if (d->coarse && all_zero(d->coarse, (size_t)l->nu * l->nv * 3)) {
+                free(d->coarse); /* as the window was built: nothing outside */
+                d->coarse = NULL;
+            }
             if (oom)
                 return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
             if (rb->short_read)
@@ -956,7 +970,8 @@ void forest_memory(const zone_forest *f, uint64_t *zones, uint64_t *occluders, u
                   (size_t)m->crossings * sizeof *m->cross;
         for (int k = 0; k < m->details; k++)
             mb += sizeof(map_detail) + (size_t)m->detail[k].ni * m->detail[k].nj +
-                  (detail_values(&m->detail[k]) + mip_values(m, 0) / m->levels / m->layout.sides) *
+                  (detail_values(&m->detail[k]) +
+                   (m->detail[k].coarse ? mip_values(m, 0) / m->levels / m->layout.sides : 0)) *
                       sizeof(float);
     }
     *maps = mb;

@@ -115,8 +115,7 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
     *d = (map_detail){level, side, i0, j0, ni, nj, sub, NULL, NULL, NULL};
     d->use = malloc((size_t)ni * nj);
     d->e = calloc((size_t)ni * nj * sub * sub * 3, sizeof(float));
-    d->coarse = calloc((size_t)nu * nv * 3, sizeof(float)); /* nothing outside */
-    if (!d->use || !d->e || !d->coarse)
+    if (!d->use || !d->e)
         return 0;
     for (int j = 0; j < nj; j++)
         for (int i = 0; i < ni; i++)

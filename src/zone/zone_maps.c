@@ -496,7 +496,10 @@ static vec3 detail_sum(const part_map *m, int level, int side, double u, double 
         double U = u + 0.5 - d->i0, V = v + 0.5 - d->j0;
         int inside = U >= 0 && V >= 0 && U < d->ni && V < d->nj &&
                      d->use[(size_t)(int)V * d->ni + (int)U];
-        e = v3_add(e, inside ? fine_read(d, U, V) : bilinear_of(m, 0, d->coarse, NULL, side, s, t, NULL));
+        if (inside)
+            e = v3_add(e, fine_read(d, U, V));
+        else if (d->coarse)
+            e = v3_add(e, bilinear_of(m, 0, d->coarse, NULL, side, s, t, NULL));
     }
     return e;
 }

@@ -65,7 +65,9 @@ typedef struct map_crossing {
  * light focused by glass is often narrower than a texel, and a texel's
  * average read back bilinearly would smear it over three.  A read adds,
  * inside a texel marked in the window, the fine grid's value; elsewhere
- * the caustic's own texels, interpolated like the map's. */
+ * the caustic's own texels, interpolated like the map's.  A refinement
+ * window (refine.c) is read the same way; its fine cells hold what the
+ * bilinear read misses, and it has nothing outside its marks. */
 typedef struct map_detail {
     int level, side;
     int i0, j0, ni, nj; /* the window: texels [i0, i0+ni) x [j0, j0+nj) */
@@ -74,7 +76,8 @@ typedef struct map_detail {
                            photons to be read */
     float *e;           /* fine irradiance [nj*sub][ni*sub][rgb] */
     float *coarse;      /* the caustic per texel of the whole map [nv][nu][rgb],
-                           in the texels too until caustic_finish takes it out */
+                           in the texels too until caustic_finish takes it out;
+                           NULL where nothing is read outside the marks */
 } map_detail;
 
 /* The grid of one part: texel values for each level and side, and coarser
