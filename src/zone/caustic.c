@@ -567,14 +567,18 @@ int caustic_finish(zone_forest *f)
         if (!m->details)
             continue;
         size_t cells = (size_t)m->layout.nu * m->layout.nv;
+        /* Refinement windows (refine.c, no coarse array) are not in the
+         * texels. */
         for (int k = 0; k < m->details; k++) {
             const map_detail *d = &m->detail[k];
+            if (!d->coarse)
+                continue;
             float *px = map_texel(m, d->level, d->side, 0, 0);
             for (size_t i = 0; i < cells * 3; i++)
                 px[i] -= d->coarse[i];
         }
         for (int k = 0; k < m->details; k++)
-            if (!map_build_mips(m, m->detail[k].level))
+            if (m->detail[k].coarse && !map_build_mips(m, m->detail[k].level))
                 return 0;
         m->detail_live = 1;
     }

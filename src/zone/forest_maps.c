@@ -224,6 +224,14 @@ static vec3 sky_texel(zone_trace *t, const zone_forest *f, vec3 x, vec3 n, const
     return v3_scale(v3(rs->sky.x, rs->sky.y, rs->sky.z), 3.14159265358979 * open / f->q.gather);
 }
 
+vec3 forest_direct_at(zone_trace *t, int part_index, vec3 x, vec3 n)
+{
+    vec3 e = direct_light_at(t, part_index, x, n);
+    if (t->f->sky_slot >= 0)
+        e = v3_add(e, sky_texel(t, t->f, x, n, t->f->dirs));
+    return e;
+}
+
 vec3 forest_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 {
     return sky_texel(t, t->f, x, n, t->f->dirs);
@@ -480,9 +488,13 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                 return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
             }
         }
+        /* Before the next level sends from this one. */
+        if (level != f->sky_slot && !refine_level(f, r, level))
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
     }
     f->rays += rays;
-    if (!caustic_finish(f) || !refine_build(f, r))
+    refine_drop_level0(f);
+    if (!caustic_finish(f))
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for maps");
     /* What only the transfer needed goes: Phase Two reads texels, weights
      * and their coarser copies, as a forest read from a file does. */

@@ -1,10 +1,12 @@
-/* Refinement of the maps that pixels read (E_1 and up) where a bilinear
- * read of texel values cannot follow the light: along the lines where
- * triangles pierce each other and where neighbouring texels differ much.
- * There the irradiance is computed exactly (the same transfer as a texel's)
- * at the centres of fine cells, and what the bilinear read misses is kept
- * as a detail window (zone_maps.h) that every read adds.  The texels stay
- * as they are: the next level's transfer sends from them.
+/* Refinement of the maps where a bilinear read of texel values cannot
+ * follow the light: along the lines where triangles pierce each other and
+ * where neighbouring texels differ much.  There the irradiance is computed
+ * exactly (E_0 as its texels are, higher levels by the same transfer as a
+ * texel's) at the centres of fine cells, and what the bilinear read misses
+ * is kept as a detail window (zone_maps.h) that every read adds.  The
+ * texels stay as they are; the next level's transfer sends from their
+ * means, and from the fine cells where a receiver is close (transfer.c).
+ * Pixels read E_1 and up, so E_0's windows go once all levels are built.
  *
  * Only maps whose irradiance is all transfer (no gathers, images in
  * spheres or caustics: scenes of flat diffuse surfaces) are refined, so
@@ -135,7 +137,8 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
             /* Twice the texels' piece size: at quality 4, triangletest's
              * level 2 was 3.84% with theta, 3.94% with 2 theta, in half the
              * time (5.56% unrefined). */
-            vec3 exact = transfer_irradiance(&t, part, x, n, level, 2.0 * f->q.theta);
+            vec3 exact = level == 0 ? forest_direct_at(&t, part, x, n)
+                                    : transfer_irradiance(&t, part, x, n, level, 2.0 * f->q.theta);
             vec3 read = map_lookup_wide(m, level, side, x, 0.0);
             float *e = d->e + 3 * ((size_t)b * fu + a);
             e[0] = (float)(exact.x - read.x);
@@ -148,9 +151,9 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
     return 1;
 }
 
-int refine_build(zone_forest *f, const zt_renderer *r)
+int refine_level(zone_forest *f, const zt_renderer *r, int level)
 {
-    if (f->q.refine_sub <= 0 || f->need_gather || f->glint_count)
+    if (f->q.refine_sub <= 0 || f->need_gather || f->glint_count || level >= f->map_levels)
         return 1;
     uint64_t rays = 0;
     for (int p = 0; p < f->map_count; p++) {
@@ -161,18 +164,39 @@ int refine_build(zone_forest *f, const zt_renderer *r)
         unsigned char *mark = malloc((size_t)l->nu * l->nv);
         if (!mark)
             return 0;
-        /* Pixels read E_1 .. E_{levels-1}; E_0 only feeds the transfer. */
-        for (int level = 1; level < f->map_levels; level++)
-            for (int side = 0; side < l->sides; side++) {
-                int n = mark_rough(m, level, side, f->q.refine_contrast, mark);
-                if (n < 0 || (n > 0 && !refine_window(f, r, p, level, side, mark, &rays))) {
-                    free(mark);
-                    return 0;
-                }
+        for (int side = 0; side < l->sides; side++) {
+            int n = mark_rough(m, level, side, f->q.refine_contrast, mark);
+            if (n < 0 || (n > 0 && !refine_window(f, r, p, level, side, mark, &rays))) {
+                free(mark);
+                return 0;
             }
+        }
         free(mark);
         m->detail_live = m->details > 0;
     }
     f->rays += rays;
     return 1;
+}
+
+void refine_drop_level0(zone_forest *f)
+{
+    for (int p = 0; p < f->map_count; p++) {
+        part_map *m = &f->maps[p];
+        int kept = 0;
+        for (int k = 0; k < m->details; k++) {
+            map_detail *d = &m->detail[k];
+            if (d->level == 0 && !d->coarse) {
+                free(d->use);
+                free(d->e);
+                continue;
+            }
+            m->detail[kept++] = *d;
+        }
+        m->details = kept;
+        m->detail_live = kept > 0;
+        if (!kept) {
+            free(m->detail);
+            m->detail = NULL;
+        }
+    }
 }

@@ -5,9 +5,14 @@
 
 #include "zone/zone_internal.h"
 
-/* Adds the refinement windows to the maps of levels 1 and up, after every
- * level is built; a no-op below the quality that asks for it or where a
- * map holds more than transfer.  Returns 0 when out of memory. */
-int refine_build(zone_forest *f, const zt_renderer *r);
+/* Adds the refinement windows of one level to the maps, once that level's
+ * texels and tables are built and before the next level is; a no-op below
+ * the quality that asks for it or where a map holds more than transfer.
+ * Returns 0 when out of memory. */
+int refine_level(zone_forest *f, const zt_renderer *r, int level);
+
+/* Frees E_0's windows once every level is built: only the transfer reads
+ * them. */
+void refine_drop_level0(zone_forest *f);
 
 #endif

@@ -82,6 +82,9 @@ static vec3 sat_sum(const part_map *m, int level, int side, int i0, int j0, int 
  * meets none of them is seen whole, with no ray cast. */
 #define BLOCKER_BOXES_MAX 256
 #define PIECE_MAX (2 * MAP_CLIPS + 8)
+/* How often a refined texel near the receiver may be halved: to an eighth,
+ * past the fine cells (a quarter at quality 5). */
+#define NEAR_DEPTH 3
 
 struct transfer_blockers {
     int boxes;          /* -1: too many parts to test, cast rays */
@@ -320,6 +323,63 @@ static vec3 split(const receiver *r, const source *src, int i0, int j0, int i1, 
     return v3_add(piece(r, src, i0, j0, i1, jm), piece(r, src, i0, jm, i1, j1));
 }
 
+/* Whether texel (i, j) of the source has fine cells (refine.c). */
+static int refined(const source *src, int i, int j)
+{
+    const part_map *m = src->m;
+    for (int k = 0; k < m->details; k++) {
+        const map_detail *d = &m->detail[k];
+        if (d->level != src->level || d->side != src->side || d->coarse)
+            continue;
+        int a = i - d->i0, b = j - d->j0;
+        if (a >= 0 && b >= 0 && a < d->ni && b < d->nj && d->use[(size_t)b * d->ni + a])
+            return 1;
+    }
+    return 0;
+}
+
+/* Rectangle [s0, s1] x [t0, t1] of a refined texel, close to the receiver:
+ * split until it looks small (at most `depth` times), each part sending the
+ * light read at its centroid (texels and fine cells) instead of the texel's
+ * mean.  Near a crossing the light on the source changes fastest right
+ * where the receiver is closest: triangletest's pixel (22, 34) at level 2
+ * went from 2.8% to 0.2% with exact light at such parts. */
+static vec3 near_piece(const receiver *r, const source *src, double s0, double s1, double t0,
+                       double t1, int depth)
+{
+    const map_layout *l = &src->m->layout;
+    vec3 q[PIECE_MAX];
+    q[0] = map_point(l, s0, t0);
+    q[2] = map_point(l, s1, t1);
+    vec3 centre = v3_scale(v3_add(q[0], q[2]), 0.5);
+    double size = v3_length(v3_sub(q[2], q[0]));
+    if (depth > 0 && size > r->theta * v3_length(v3_sub(centre, r->x))) {
+        double sm = 0.5 * (s0 + s1), tm = 0.5 * (t0 + t1);
+        vec3 a = v3_add(near_piece(r, src, s0, sm, t0, tm, depth - 1),
+                        near_piece(r, src, sm, s1, t0, tm, depth - 1));
+        vec3 b = v3_add(near_piece(r, src, s0, sm, tm, t1, depth - 1),
+                        near_piece(r, src, sm, s1, tm, t1, depth - 1));
+        return v3_add(a, b);
+    }
+    q[1] = map_point(l, s1, t0);
+    q[3] = map_point(l, s0, t1);
+    int n = 4;
+    for (int k = 0; k < l->clips && n >= 3; k++)
+        n = poly3_clip(q, n, PIECE_MAX, l->clip_n[k], l->clip_d[k]);
+    if (n >= 3)
+        n = poly3_clip(q, n, PIECE_MAX, r->n, -v3_dot(r->n, r->x));
+    if (n < 3)
+        return v3(0, 0, 0);
+    double ff = lambert_polygon(r->x, r->n, q, n);
+    if (ff <= 0 || !seen(r, src, q, n))
+        return v3(0, 0, 0);
+    vec3 c = v3(0, 0, 0);
+    for (int k = 0; k < n; k++)
+        c = v3_add(c, q[k]);
+    vec3 e = map_lookup_wide(src->m, src->level, src->side, v3_scale(c, 1.0 / n), 0.0);
+    return v3_scale(v3_mul(e, src->scale), ff);
+}
+
 static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, int j1)
 {
     const map_layout *l = &src->m->layout;
@@ -334,6 +394,8 @@ static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, 
     int splittable = i1 - i0 > 1 || j1 - j0 > 1;
     if (size > r->theta * dist && splittable)
         return split(r, src, i0, j0, i1, j1);
+    if (size > r->theta * dist && src->m->detail_live && refined(src, i0, j0))
+        return near_piece(r, src, s0, s1, t0, t1, NEAR_DEPTH);
     double area;
     vec3 sum = sat_sum(src->m, src->level, src->side, i0, j0, i1, j1, &area);
     if (area <= 0 || (sum.x <= 0 && sum.y <= 0 && sum.z <= 0))

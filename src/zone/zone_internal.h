@@ -108,6 +108,9 @@ typedef struct zone_trace {
  * the forest's directions: camera samples take it here rather than from
  * the map, which smears it where surfaces meet or cross. */
 vec3 forest_sky_irradiance(zone_trace *t, vec3 x, vec3 n);
+/* E_0 at point x (normal n) of a part as a level-0 texel has it: every
+ * light exactly, plus the sky by the gather directions. */
+vec3 forest_direct_at(zone_trace *t, int part_index, vec3 x, vec3 n);
 
 enum {
     ZR_EXACT_DIRECT = 1, /* level 1 from the analytic direct term, not maps */

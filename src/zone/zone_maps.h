@@ -182,6 +182,11 @@ int map_build_mips(part_map *m, int level);
  * footprint of about `width` scene units (0: the finest grid). */
 vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double width);
 
+/* Whether point p of a planar part lies in a texel some refinement window
+ * (refine.c) holds fine cells for, at any level: the light there changes
+ * within a texel, and may within a pixel. */
+int map_refined_at(const part_map *m, vec3 p);
+
 /* Frees what only Phase One uses (cover, evaluation points, the
  * transfer's tables). */
 void map_free_phase_one(part_map *m);
