@@ -114,7 +114,9 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
         return 0;
     m->detail = nd;
     map_detail *d = &m->detail[m->details++];
-    *d = (map_detail){level, side, i0, j0, ni, nj, sub, NULL, NULL, NULL};
+    /* Level -1 while its cells are filled, so that the reads below (on
+     * other threads too) leave it out. */
+    *d = (map_detail){-1, side, i0, j0, ni, nj, sub, NULL, NULL, NULL};
     d->use = malloc((size_t)ni * nj);
     d->e = calloc((size_t)ni * nj * sub * sub * 3, sizeof(float));
     if (!d->use || !d->e)
@@ -147,6 +149,7 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
         }
         count += t.rays;
     }
+    d->level = level;
     *rays += count;
     return 1;
 }
