@@ -36,9 +36,10 @@
 #include "camera/camera.h"
 #include "zone/zone_internal.h"
 
-/* At most this many samples in one pixel: the 4 x 4 subset of the 16 x 16
- * edge grid plus one per surface that misses it. */
-#define P2_MAX_PIXEL_SAMPLES (16 * 16 + 16)
+/* The samples a pixel has at most but for dense meshes (whose extra
+ * surfaces add one each): the 32 x 32 shaded on the fine grid of a pixel
+ * over a refined texel, plus one per surface that misses them. */
+#define P2_MAX_PIXEL_SAMPLES (32 * 32 + 16)
 
 /* One shaded camera sample. */
 typedef struct p2_sample {

@@ -24,6 +24,10 @@
 
 #define FINE_GRID 64   /* the grid where a light is seen by way of a mirror */
 #define FINE_SHADE 16  /* and its shaded samples per side */
+/* Shaded samples per side of a pixel over a refined texel (on the fine
+ * grid): triangletest's level 2 at quality 5 went from 1.69% with 16 to
+ * 1.59% with 32, Phase Two 0.42 s to 0.49 s. */
+#define REFINED_SHADE 32
 #define SEEN_MAX 8     /* light parts listed per pixel */
 #define CURVED_GRID 2  /* sub-pixel grid of smooth pixels that see a sphere */
 /* Specular steps a signature follows.  Fixed, not the render's depth: the
@@ -363,8 +367,8 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
          * leave slivers between them, so both come from the fine grid.
          * Where a map is refined, the light changes within the pixel. */
         row->sample_count = start;
-        if (!edge_samples(c, px, py, FINE_GRID, FINE_SHADE, *scratch, lights, row, rays,
-                          &glint, &rim, rim))
+        if (!edge_samples(c, px, py, FINE_GRID, refined ? REFINED_SHADE : FINE_SHADE, *scratch,
+                          lights, row, rays, &glint, &rim, rim))
             return 0;
     }
     return 1;
