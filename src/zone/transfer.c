@@ -323,21 +323,6 @@ static vec3 split(const receiver *r, const source *src, int i0, int j0, int i1, 
     return v3_add(piece(r, src, i0, j0, i1, jm), piece(r, src, i0, jm, i1, j1));
 }
 
-/* Whether texel (i, j) of the source has fine cells (refine.c). */
-static int refined(const source *src, int i, int j)
-{
-    const part_map *m = src->m;
-    for (int k = 0; k < m->details; k++) {
-        const map_detail *d = &m->detail[k];
-        if (d->level != src->level || d->side != src->side || d->coarse)
-            continue;
-        int a = i - d->i0, b = j - d->j0;
-        if (a >= 0 && b >= 0 && a < d->ni && b < d->nj && d->use[(size_t)b * d->ni + a])
-            return 1;
-    }
-    return 0;
-}
-
 /* Rectangle [s0, s1] x [t0, t1] of a refined texel, close to the receiver:
  * split until it looks small (at most `depth` times), each part sending the
  * light read at its centroid (texels and fine cells) instead of the texel's
@@ -394,7 +379,8 @@ static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, 
     int splittable = i1 - i0 > 1 || j1 - j0 > 1;
     if (size > r->theta * dist && splittable)
         return split(r, src, i0, j0, i1, j1);
-    if (size > r->theta * dist && src->m->detail_live && refined(src, i0, j0))
+    if (size > r->theta * dist && src->m->detail_live &&
+        map_refined_texel(src->m, src->level, src->side, i0, j0))
         return near_piece(r, src, s0, s1, t0, t1, NEAR_DEPTH);
     double area;
     vec3 sum = sat_sum(src->m, src->level, src->side, i0, j0, i1, j1, &area);

@@ -504,21 +504,26 @@ static vec3 detail_sum(const part_map *m, int level, int side, double u, double 
     return e;
 }
 
+int map_refined_texel(const part_map *m, int level, int side, int i, int j)
+{
+    for (int k = 0; k < m->details; k++) {
+        const map_detail *d = &m->detail[k];
+        if (d->coarse || (level >= 0 && (d->level != level || d->side != side)))
+            continue;
+        int a = i - d->i0, b = j - d->j0;
+        if (a >= 0 && b >= 0 && a < d->ni && b < d->nj && d->use[(size_t)b * d->ni + a])
+            return 1;
+    }
+    return 0;
+}
+
 int map_refined_at(const part_map *m, vec3 p)
 {
     if (!m->details || !m->detail_live || m->layout.shape == SHAPE_SPHERE)
         return 0;
     double u, v;
     map_coords(&m->layout, p, &u, &v);
-    for (int k = 0; k < m->details; k++) {
-        const map_detail *d = &m->detail[k];
-        if (d->coarse)
-            continue;
-        int a = (int)floor(u + 0.5) - d->i0, b = (int)floor(v + 0.5) - d->j0;
-        if (a >= 0 && b >= 0 && a < d->ni && b < d->nj && d->use[(size_t)b * d->ni + a])
-            return 1;
-    }
-    return 0;
+    return map_refined_texel(m, -1, 0, (int)floor(u + 0.5), (int)floor(v + 0.5));
 }
 
 vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double width)

@@ -186,6 +186,9 @@ vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double widt
  * (refine.c) holds fine cells for, at any level: the light there changes
  * within a texel, and may within a pixel. */
 int map_refined_at(const part_map *m, vec3 p);
+/* Whether texel (i, j) has fine cells in a refinement window of the level
+ * and side (level < 0: of any). */
+int map_refined_texel(const part_map *m, int level, int side, int i, int j);
 
 /* Frees what only Phase One uses (cover, evaluation points, the
  * transfer's tables). */
