@@ -5,13 +5,15 @@
  * differ, an edge crosses the pixel: a 16 x 16 grid (32 x 32 at quality 3,
  * 64 x 64 from 4) measures the coverage of each surface (group of equal
  * signatures), and each group is shaded on the samples of a sparse 4 x 4
- * (8 x 8 from quality 4) subset that fall in it (or on the cell nearest
- * its centroid when it misses the subset), weighted by its coverage.  Where
+ * (8 x 8 at quality 4, 16 x 16 from 5) subset that fall in it (or on the
+ * point nearest its centroid when it misses the subset), weighted by its
+ * coverage; from quality 5 the grid's points are quasi-random.  Where
  * a light is seen in a mirror or through glass, where phase_two_marks.c
  * expects a light's small image in a sphere, or where a sample falls in a
  * refined texel (refine.c), the grid is 64 x 64.  Light
  * parts seen at a corner or a sample, or with a vertex in the pixel, are
  * listed for the exact level-0 coverage. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -223,7 +225,34 @@ typedef struct edge_grid {
     int group_shaded[FINE_GRID * FINE_GRID];
 } edge_grid;
 
-/* Samples of an edge pixel from an n x n coverage grid, shaded on a
+/* Point i of an edge pixel's n x n coverage points, in [0, 1)^2: the
+ * centre of cell i, or the i-th point of Roberts' R2 sequence (additive
+ * recurrence on the plastic number), whose every prefix is spread evenly
+ * and which lines up with no edge direction. */
+static void cover_point(int quasi, int n, int i, float *u, float *v)
+{
+    if (quasi) {
+        const double g = 1.32471795724474602596; /* x^3 = x + 1 */
+        double a = 0.5 + i / g, b = 0.5 + i / (g * g);
+        *u = (float)(a - floor(a));
+        *v = (float)(b - floor(b));
+    } else {
+        *u = (i % n + 0.5f) / n;
+        *v = (i / n + 0.5f) / n;
+    }
+}
+
+/* Whether coverage point i is shaded: every (n / shade)-th cell per side,
+ * or the first shade^2 points of the sequence. */
+static int cover_shaded(int quasi, int n, int shade, int i)
+{
+    if (quasi)
+        return i < shade * shade;
+    int step = n / shade, sx = i % n, sy = i / n;
+    return sx % step == step / 2 && sy % step == step / 2;
+}
+
+/* Samples of an edge pixel from n x n coverage points, shaded on a
  * shade x shade subset.  *glint is set when some sub-pixel sees a light by
  * way of a specular surface, *rim when a light and a sphere are both seen
  * first.  With `measure`, the lights' coverage is taken from the grid. */
@@ -233,12 +262,14 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
 {
     int saw_light = 0, saw_sphere = 0;
     const rscene *rs = &c->r->rs;
-    const int cells = n * n, step = n / shade;
+    const int cells = n * n, quasi = c->f->q.cover_quasi;
     int groups = 0;
     vec3f org, dir;
+    float u, v;
     for (int i = 0; i < cells; i++) {
-        int sx = i % n, sy = i / n, via = 0;
-        cam_ray(&c->c, (float)px + (sx + 0.5f) / n, (float)py + (sy + 0.5f) / n, &org, &dir);
+        int via = 0;
+        cover_point(quasi, n, i, &u, &v);
+        cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
         e->sig[i] = ray_signature(rs, org, dir, rays, &e->hits[i], NULL, &via);
         *glint |= via;
         note_light(rs, lights, e->hits[i].part);
@@ -258,7 +289,7 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
         }
         e->group_of[i] = k;
         e->group_count[k]++;
-        if ((sx % step == step / 2) && (sy % step == step / 2))
+        if (cover_shaded(quasi, n, shade, i))
             e->group_shaded[k]++;
     }
     *rim = saw_light && saw_sphere;
@@ -271,16 +302,17 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
         }
     /* The subset's samples, weighted by their group's coverage. */
     for (int i = 0; i < cells; i++) {
-        int sx = i % n, sy = i / n, k = e->group_of[i];
-        if (!((sx % step == step / 2) && (sy % step == step / 2)))
+        int k = e->group_of[i];
+        if (!cover_shaded(quasi, n, shade, i))
             continue;
-        cam_ray(&c->c, (float)px + (sx + 0.5f) / n, (float)py + (sy + 0.5f) / n, &org, &dir);
+        cover_point(quasi, n, i, &u, &v);
+        cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
         double w = (double)e->group_count[k] / ((double)e->group_shaded[k] * cells);
         if (!push_sample(row, org, dir, e->hits[i], w))
             return 0;
     }
-    /* Surfaces too small to meet the subset: the cell nearest their
-     * centroid (their first cell lies on their rim, where what they show
+    /* Surfaces too small to meet the subset: the point nearest their
+     * centroid (their first point lies on their rim, where what they show
      * can differ most from their mean). */
     for (int k = 0; k < groups; k++) {
         if (e->group_shaded[k])
@@ -288,22 +320,26 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
         double cx = 0, cy = 0;
         for (int i = 0; i < cells; i++)
             if (e->group_of[i] == k) {
-                cx += i % n;
-                cy += i / n;
+                cover_point(quasi, n, i, &u, &v);
+                cx += u;
+                cy += v;
             }
         cx /= e->group_count[k];
         cy /= e->group_count[k];
         int best = -1;
         double best_d2 = 1e300;
         for (int i = 0; i < cells; i++) {
-            double dx = i % n - cx, dy = i / n - cy, d2 = dx * dx + dy * dy;
-            if (e->group_of[i] == k && d2 < best_d2) {
+            if (e->group_of[i] != k)
+                continue;
+            cover_point(quasi, n, i, &u, &v);
+            double dx = u - cx, dy = v - cy, d2 = dx * dx + dy * dy;
+            if (d2 < best_d2) {
                 best = i;
                 best_d2 = d2;
             }
         }
-        int sx = best % n, sy = best / n;
-        cam_ray(&c->c, (float)px + (sx + 0.5f) / n, (float)py + (sy + 0.5f) / n, &org, &dir);
+        cover_point(quasi, n, best, &u, &v);
+        cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
         if (!push_sample(row, org, dir, e->hits[best], (double)e->group_count[k] / cells))
             return 0;
     }

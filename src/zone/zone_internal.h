@@ -46,6 +46,8 @@ typedef struct zone_quality {
     int edge_grade;     /* maps' end texels cut this many times (map_axis) */
     int edge_grid;      /* coverage grid of a pixel an edge crosses (<= 64) */
     int edge_shade;     /* its shaded subset, per side (divides edge_grid) */
+    int cover_quasi;    /* coverage points: 0 the n x n cell centres, 1 the
+                           first n^2 of a quasi-random (R2) sequence */
     int probe;          /* signatures per side that look for an edge in a
                            pixel (no more than aa: the samples' own) */
     int photons;        /* caustic photons per light (caustic.h) */
