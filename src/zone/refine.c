@@ -54,6 +54,20 @@ static int mark_rough(const part_map *m, int level, int side, double contrast,
                 double b = texel_level(v + 3 * k2);
                 rough = fabs(a - b) > contrast * fmax(a, b);
             }
+            /* A kink (the trace of another surface's plane, where its
+             * light fades to grazing) bends the texels without a step. */
+            static double kink = -1;
+            if (kink < 0) kink = getenv("ZT_KINK") ? atof(getenv("ZT_KINK")) : 0;
+            for (int q = 0; q < 2 && !rough && kink > 0; q++) {
+                int ia = i - (q == 0), ib = i + (q == 0), ja = j - (q == 1), jb = j + (q == 1);
+                if (ia < 0 || ja < 0 || ib >= nu || jb >= nv)
+                    continue;
+                size_t ka = (size_t)ja * nu + ia, kb = (size_t)jb * nu + ib;
+                if (wt[ka] <= 0 || wt[kb] <= 0)
+                    continue;
+                double b = texel_level(v + 3 * ka), c2 = texel_level(v + 3 * kb);
+                rough = fabs(b + c2 - 2 * a) > kink * fmax(a, fmax(b, c2));
+            }
             core[k] = (unsigned char)rough;
         }
     /* And a ring around: a fine read blends with its neighbour cells, and

@@ -465,28 +465,62 @@ static vec3 bilinear(const part_map *m, int k, int level, int side, double s, do
                        t, x);
 }
 
-/* Bilinear between fine cell centres (held at the window's edge cells). */
-static vec3 fine_read(const map_detail *d, double U, double V)
+/* Bilinear between fine cell centres (held at the window's edge cells).
+ * Where a crossing passes among the four cells, those it separates from x
+ * (the point read) do not take part: the light jumps there, and the
+ * cells on the far side hold what the read misses over there. */
+static vec3 fine_read(const part_map *m, const map_detail *d, double U, double V, vec3 x)
 {
     int nu = d->ni * d->sub, nv = d->nj * d->sub;
     double fu = fmax(0.0, fmin(U * d->sub - 0.5, nu - 1.0));
     double fv = fmax(0.0, fmin(V * d->sub - 0.5, nv - 1.0));
     int a = (int)fu, b = (int)fv;
     int a1 = a + 1 < nu ? a + 1 : a, b1 = b + 1 < nv ? b + 1 : b;
-    double x = fu - a, y = fv - b;
-    const float *e = d->e;
-    const float *p00 = e + ((size_t)b * nu + a) * 3, *p10 = e + ((size_t)b * nu + a1) * 3;
-    const float *p01 = e + ((size_t)b1 * nu + a) * 3, *p11 = e + ((size_t)b1 * nu + a1) * 3;
-    double w00 = (1 - x) * (1 - y), w10 = x * (1 - y), w01 = (1 - x) * y, w11 = x * y;
-    return v3(w00 * p00[0] + w10 * p10[0] + w01 * p01[0] + w11 * p11[0],
-              w00 * p00[1] + w10 * p10[1] + w01 * p01[1] + w11 * p11[1],
-              w00 * p00[2] + w10 * p10[2] + w01 * p01[2] + w11 * p11[2]);
+    double fx = fu - a, fy = fv - b;
+    int ca[4] = {a, a1, a, a1}, cb[4] = {b, b, b1, b1};
+    double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+    if (m->crossings > 0) {
+        /* Only texels a crossing cuts can hold cells it separates. */
+        const map_layout *l = &m->layout;
+        int cut = 0;
+        for (int q = 0; q < 4 && !cut; q++) {
+            int i = d->i0 + ca[q] / d->sub, j = d->j0 + cb[q] / d->sub;
+            cut = m->cut[(size_t)j * l->nu + i] >= 0;
+        }
+        int ix = d->i0 + (int)floor(U), jx = d->j0 + (int)floor(V);
+        if (ix >= 0 && jx >= 0 && ix < l->nu && jx < l->nv)
+            cut |= m->cut[(size_t)jx * l->nu + ix] >= 0;
+        if (cut) {
+            double sw = 0;
+            for (int q = 0; q < 4; q++) {
+                int i = d->i0 + ca[q] / d->sub, j = d->j0 + cb[q] / d->sub;
+                int su = ca[q] % d->sub, sv = cb[q] % d->sub;
+                double s0 = axis_edge(&l->au, i), s1 = axis_edge(&l->au, i + 1);
+                double t0 = axis_edge(&l->av, j), t1 = axis_edge(&l->av, j + 1);
+                vec3 c = map_point(l, s0 + (s1 - s0) * (su + 0.5) / d->sub,
+                                   t0 + (t1 - t0) * (sv + 0.5) / d->sub);
+                if (map_separated(m, x, c, -1))
+                    w[q] = 0;
+                sw += w[q];
+            }
+            if (sw <= 1e-9)
+                return v3(0, 0, 0);
+            for (int q = 0; q < 4; q++)
+                w[q] /= sw;
+        }
+    }
+    vec3 r = v3(0, 0, 0);
+    for (int q = 0; q < 4; q++) {
+        const float *e = d->e + ((size_t)cb[q] * nu + ca[q]) * 3;
+        r = v3_add(r, v3(w[q] * e[0], w[q] * e[1], w[q] * e[2]));
+    }
+    return r;
 }
 
 /* The caustics of a level and side at grid point (u, v) (texel units, as
  * map_coords gives them; s, t normalised). */
 static vec3 detail_sum(const part_map *m, int level, int side, double u, double v, double s,
-                       double t)
+                       double t, vec3 x)
 {
     vec3 e = v3(0, 0, 0);
     for (int k = 0; k < m->details; k++) {
@@ -497,7 +531,7 @@ static vec3 detail_sum(const part_map *m, int level, int side, double u, double 
         int inside = U >= 0 && V >= 0 && U < d->ni && V < d->nj &&
                      d->use[(size_t)(int)V * d->ni + (int)U];
         if (inside)
-            e = v3_add(e, fine_read(d, U, V));
+            e = v3_add(e, fine_read(m, d, U, V, x));
         else if (d->coarse)
             e = v3_add(e, bilinear_of(m, 0, d->coarse, NULL, side, s, t, NULL));
     }
@@ -538,7 +572,7 @@ vec3 map_lookup_wide(const part_map *m, int level, int side, vec3 p, double widt
     /* The caustics kept apart, once they have left the texels (the wide
      * reads of Phase One's gathers come before that and find them there). */
     vec3 detail = m->details && m->detail_live
-                      ? detail_sum(m, level, side, u, v, (u + 0.5) / l->nu, (v + 0.5) / l->nv)
+                      ? detail_sum(m, level, side, u, v, (u + 0.5) / l->nu, (v + 0.5) / l->nv, p)
                       : v3(0, 0, 0);
     double s = (u + 0.5) / l->nu, t = (v + 0.5) / l->nv;
     double texel = l->shape == SHAPE_SPHERE
