@@ -23,8 +23,10 @@
 static double texel_level(const float *v) { return v[0] + v[1] + v[2]; }
 
 /* Marks the texels of one level and side to refine (1) and returns how
- * many; `mark` has nu x nv entries. */
-static int mark_rough(const part_map *m, int level, int side, double contrast,
+ * many; `mark` has nu x nv entries.  A texel is rough where a crossing
+ * cuts it, a neighbour differs by more than `contrast`, or its second
+ * difference along an axis exceeds `kink` (shares of the largest). */
+static int mark_rough(const part_map *m, int level, int side, double contrast, double kink,
                       unsigned char *mark)
 {
     const map_layout *l = &m->layout;
@@ -54,10 +56,9 @@ static int mark_rough(const part_map *m, int level, int side, double contrast,
                 double b = texel_level(v + 3 * k2);
                 rough = fabs(a - b) > contrast * fmax(a, b);
             }
-            /* A kink (the trace of another surface's plane, where its
-             * light fades to grazing) bends the texels without a step. */
-            static double kink = -1;
-            if (kink < 0) kink = getenv("ZT_KINK") ? atof(getenv("ZT_KINK")) : 0;
+            /* A kink bends the texels without a step: where a receiver
+             * crosses another surface's plane, that surface's light fades
+             * to grazing and rises again on its other face. */
             for (int q = 0; q < 2 && !rough && kink > 0; q++) {
                 int ia = i - (q == 0), ib = i + (q == 0), ja = j - (q == 1), jb = j + (q == 1);
                 if (ia < 0 || ja < 0 || ib >= nu || jb >= nv)
@@ -65,8 +66,8 @@ static int mark_rough(const part_map *m, int level, int side, double contrast,
                 size_t ka = (size_t)ja * nu + ia, kb = (size_t)jb * nu + ib;
                 if (wt[ka] <= 0 || wt[kb] <= 0)
                     continue;
-                double b = texel_level(v + 3 * ka), c2 = texel_level(v + 3 * kb);
-                rough = fabs(b + c2 - 2 * a) > kink * fmax(a, fmax(b, c2));
+                double b = texel_level(v + 3 * ka), c = texel_level(v + 3 * kb);
+                rough = fabs(b + c - 2 * a) > kink * fmax(a, fmax(b, c));
             }
             core[k] = (unsigned char)rough;
         }
@@ -182,7 +183,7 @@ int refine_level(zone_forest *f, const zt_renderer *r, int level)
         if (!mark)
             return 0;
         for (int side = 0; side < l->sides; side++) {
-            int n = mark_rough(m, level, side, f->q.refine_contrast, mark);
+            int n = mark_rough(m, level, side, f->q.refine_contrast, f->q.refine_kink, mark);
             if (n < 0 || (n > 0 && !refine_window(f, r, p, level, side, mark, &rays))) {
                 free(mark);
                 return 0;

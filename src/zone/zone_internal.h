@@ -55,6 +55,8 @@ typedef struct zone_quality {
                            (refine.h; 0: none) */
     double refine_contrast; /* texels refined where a neighbour differs by
                                more than this share */
+    double refine_kink; /* or where the second difference exceeds this
+                           share (0: not looked for) */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;
