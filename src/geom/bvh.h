@@ -24,10 +24,11 @@ typedef struct bvh4_node {
 } bvh4_node;
 
 /* Up to four primitives of one shape.  Unused lanes have zero edges and
- * part -1: their triangle test fails on the determinant. */
+ * normals and part -1: their triangle test fails on the determinant. */
 typedef struct bvh_packet {
     f4 p0[3];           /* triangle vertex 0 or sphere centre, by axis */
     f4 e1[3], e2[3];    /* triangle edges */
+    f4 n[3];            /* triangle unit normal, for t */
     f4 radius;
     i4 culled;          /* -1 culled, else 0 */
     int32_t part[BVH_WIDTH];

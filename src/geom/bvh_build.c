@@ -308,7 +308,7 @@ static void packet_init(bvh_packet *q, int shape)
 {
     for (int i = 0; i < BVH_WIDTH; i++) {
         for (int a = 0; a < 3; a++)
-            q->p0[a][i] = q->e1[a][i] = q->e2[a][i] = 0.0f;
+            q->p0[a][i] = q->e1[a][i] = q->e2[a][i] = q->n[a][i] = 0.0f;
         q->radius[i] = 0.0f;
         q->culled[i] = 0;
         q->part[i] = -1;
@@ -328,6 +328,7 @@ static void packet_set(bvh_packet *q, int lane, const rs_part *p, int part)
     lane_put(q->p0, lane, p->p0);
     lane_put(q->e1, lane, p->e1);
     lane_put(q->e2, lane, p->e2);
+    lane_put(q->n, lane, p->n);
     q->radius[lane] = p->radius;
     q->culled[lane] = p->culled ? -1 : 0;
     q->part[lane] = part;

@@ -122,9 +122,13 @@ static inline int bvh_triangle_packet(const bvh_packet *q, const ray4 *r,
     f4 qvy = tvz * e1[0] - tvx * e1[2];
     f4 qvz = tvx * e1[1] - tvy * e1[0];
     f4 v = (dx * qvx + dy * qvy + dz * qvz) * inv;
-    *t = (e2[0] * qvx + e2[1] * qvy + e2[2] * qvz) * inv;
+    const f4 *n = q->n;
+    f4 dn = n[0] * dx + n[1] * dy + n[2] * dz;
+    /* Lanes with dn = 0 get inf or NaN here and are misses below. */
+    *t = -(n[0] * tvx + n[1] * tvy + n[2] * tvz) / dn;
     f4 zero = f4_splat(0.0f), one = f4_splat(1.0f);
-    i4 miss = (q->culled & (det <= zero)) | (~q->culled & (det == zero)) |
+    i4 miss = (q->culled & ((det <= zero) | (dn >= zero))) |
+              (~q->culled & ((det == zero) | (dn == zero))) |
               (u < zero) | (u > one) | (v < zero) | (u + v > one);
     i4 hit = ~miss & (*t > zero) & (*t < f4_splat(tmax));
     return i4_bits(hit);

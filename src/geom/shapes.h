@@ -22,7 +22,12 @@ static inline float shape_plane_hit(const rs_part *p, vec3f o, vec3f d,
     return (t > tmin && t < tmax) ? t : -1.0f;
 }
 
-/* Moeller-Trumbore. */
+/* Moeller-Trumbore for the inside test (u, v); t comes from the plane.
+ * MT's t, e2.qv / det, loses digits when e1 and e2 are nearly parallel
+ * (det cancels): a sliver listed from its sharp end had hits 2e-5 below
+ * its plane, beyond ray_offset, and shadowed itself.  With n (unit, from
+ * double precision) the hit is within a few ulps of |o - p0| of the plane
+ * whatever the triangle's shape. */
 static inline float shape_triangle_hit(const rs_part *p, vec3f o, vec3f d,
                                        float tmin, float tmax)
 {
@@ -40,7 +45,13 @@ static inline float shape_triangle_hit(const rs_part *p, vec3f o, vec3f d,
     float v = f3_dot(d, qv) * inv;
     if (v < 0.0f || u + v > 1.0f)
         return -1.0f;
-    float t = f3_dot(p->e2, qv) * inv;
+    float dn = f3_dot(p->n, d);
+    /* Parallel: a miss, not t = inf or NaN.  Culled: dn must agree with
+     * det that the ray meets the front, or a grazing ray whose two
+     * roundings disagree could hit from behind. */
+    if (p->culled ? dn >= 0.0f : dn == 0.0f)
+        return -1.0f;
+    float t = -f3_dot(p->n, tv) / dn;
     return (t > tmin && t < tmax) ? t : -1.0f;
 }
 
