@@ -42,8 +42,9 @@ zone_quality zone_quality_for(const zt_scene *sc, int q)
      * made triangletest's pixel (23, 33) 1.6% too dark at quality 5, and
      * more shaded samples did not help.  A quasi-random set has no such
      * direction: level 2 went from 1.59% to 1.42% with 16 x 16 shaded.  At
-     * quality 4 the maps' error dominates (5.6% either way, Cornell's
-     * levels the same), so the images of qualities 0-4 are kept. */
+     * quality 4 the maps' error dominates (level 2: 5.6% on the grid, 6.0%
+     * on R2; Cornell's levels within 0.04 points), so the images of
+     * qualities 0-4 are kept. */
     z.cover_quasi = q >= 5;
     /* Signatures that look for edges inside smooth-looking pixels:
      * triangletest's level 1 at 64x64, quality 4, went from 6.1% to 1.8%
