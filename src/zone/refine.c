@@ -98,11 +98,9 @@ static int mark_rough(const part_map *m, int level, int side, double contrast, d
 static void cell_point(const map_layout *l, int i, int j, int su, int sv, int sub, int side,
                        vec3 *x, vec3 *n)
 {
-    double s0 = axis_edge(&l->au, i), s1 = axis_edge(&l->au, i + 1);
-    double t0 = axis_edge(&l->av, j), t1 = axis_edge(&l->av, j + 1);
     vec3 p;
     map_texel_point(l, i, j, &p, n);
-    *x = map_point(l, s0 + (s1 - s0) * (su + 0.5) / sub, t0 + (t1 - t0) * (sv + 0.5) / sub);
+    *x = map_cell_centre(l, i, j, su, sv, sub);
     if (side)
         *n = v3_scale(*n, -1);
 }

@@ -323,6 +323,29 @@ static vec3 split(const receiver *r, const source *src, int i0, int j0, int i1, 
     return v3_add(piece(r, src, i0, j0, i1, jm), piece(r, src, i0, jm, i1, j1));
 }
 
+/* Polygon q (n corners) of a source cut to the surface that exists (a
+ * triangle, a plane inside its room); returns its corners left (< 3:
+ * nothing). */
+static int clip_to_surface(const map_layout *l, vec3 *q, int n)
+{
+    for (int k = 0; k < l->clips && n >= 3; k++)
+        n = poly3_clip(q, n, PIECE_MAX, l->clip_n[k], l->clip_d[k]);
+    return n;
+}
+
+/* The form factor from the receiver of source polygon q (*n corners, fewer
+ * than 3: none), cut in place to the receiver's horizon; 0 where nothing
+ * is left or a ray finds the polygon hidden. */
+static double seen_form_factor(const receiver *r, const source *src, vec3 *q, int *n)
+{
+    if (*n >= 3)
+        *n = poly3_clip(q, *n, PIECE_MAX, r->n, -v3_dot(r->n, r->x));
+    if (*n < 3)
+        return 0;
+    double ff = lambert_polygon(r->x, r->n, q, *n);
+    return ff > 0 && seen(r, src, q, *n) ? ff : 0;
+}
+
 /* Rectangle [s0, s1] x [t0, t1] of a refined texel, close to the receiver:
  * split until it looks small (at most `depth` times), each part sending the
  * light read at its centroid (texels and fine cells) instead of the texel's
@@ -348,15 +371,9 @@ static vec3 near_piece(const receiver *r, const source *src, double s0, double s
     }
     q[1] = map_point(l, s1, t0);
     q[3] = map_point(l, s0, t1);
-    int n = 4;
-    for (int k = 0; k < l->clips && n >= 3; k++)
-        n = poly3_clip(q, n, PIECE_MAX, l->clip_n[k], l->clip_d[k]);
-    if (n >= 3)
-        n = poly3_clip(q, n, PIECE_MAX, r->n, -v3_dot(r->n, r->x));
-    if (n < 3)
-        return v3(0, 0, 0);
-    double ff = lambert_polygon(r->x, r->n, q, n);
-    if (ff <= 0 || !seen(r, src, q, n))
+    int n = clip_to_surface(l, q, 4);
+    double ff = seen_form_factor(r, src, q, &n);
+    if (ff <= 0)
         return v3(0, 0, 0);
     vec3 c = v3(0, 0, 0);
     for (int k = 0; k < n; k++)
@@ -389,10 +406,8 @@ static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, 
     vec3 radiance = v3_mul(v3_scale(sum, 1.0 / area), src->scale);
     q[1] = map_point(l, s1, t0);
     q[3] = map_point(l, s0, t1);
-    int n = 4;
     /* Only the surface that exists (a triangle, a plane inside its room)... */
-    for (int k = 0; k < l->clips && n >= 3; k++)
-        n = poly3_clip(q, n, PIECE_MAX, l->clip_n[k], l->clip_d[k]);
+    int n = clip_to_surface(l, q, 4);
     /* ...above the receiver's horizon.  Where the receiver's surface
      * pierces the source, the part of the source in front of it is lit
      * differently from the part behind: such pieces go down to texels, and
@@ -410,14 +425,8 @@ static vec3 piece(const receiver *r, const source *src, int i0, int j0, int i1, 
             radiance = v3_mul(front_half(src->m, src->level, src->side, i0, j0, r), src->scale);
         }
     }
-    if (n >= 3)
-        n = poly3_clip(q, n, PIECE_MAX, r->n, -v3_dot(r->n, r->x));
-    if (n < 3)
-        return v3(0, 0, 0);
-    double ff = lambert_polygon(r->x, r->n, q, n);
-    if (ff <= 0)
-        return v3(0, 0, 0);
-    return seen(r, src, q, n) ? v3_scale(radiance, ff) : v3(0, 0, 0);
+    double ff = seen_form_factor(r, src, q, &n);
+    return ff > 0 ? v3_scale(radiance, ff) : v3(0, 0, 0);
 }
 
 vec3 transfer_irradiance(zone_trace *t, int receiver_part, vec3 x, vec3 n, int level,

@@ -83,6 +83,13 @@ vec3 map_point(const map_layout *l, double s, double t)
     return v3_add(l->origin, v3_add(v3_scale(l->du, s), v3_scale(l->dv, t)));
 }
 
+vec3 map_cell_centre(const map_layout *l, int i, int j, int su, int sv, int sub)
+{
+    double s0 = axis_edge(&l->au, i), s1 = axis_edge(&l->au, i + 1);
+    double t0 = axis_edge(&l->av, j), t1 = axis_edge(&l->av, j + 1);
+    return map_point(l, s0 + (s1 - s0) * (su + 0.5) / sub, t0 + (t1 - t0) * (sv + 0.5) / sub);
+}
+
 /* Solves p - origin = s du + t dv in the least-squares sense (du, dv span
  * the plane). */
 static void plane_st(const map_layout *l, vec3 p, double *s, double *t)
@@ -493,12 +500,8 @@ static vec3 fine_read(const part_map *m, const map_detail *d, double U, double V
         if (cut) {
             double sw = 0;
             for (int q = 0; q < 4; q++) {
-                int i = d->i0 + ca[q] / d->sub, j = d->j0 + cb[q] / d->sub;
-                int su = ca[q] % d->sub, sv = cb[q] % d->sub;
-                double s0 = axis_edge(&l->au, i), s1 = axis_edge(&l->au, i + 1);
-                double t0 = axis_edge(&l->av, j), t1 = axis_edge(&l->av, j + 1);
-                vec3 c = map_point(l, s0 + (s1 - s0) * (su + 0.5) / d->sub,
-                                   t0 + (t1 - t0) * (sv + 0.5) / d->sub);
+                vec3 c = map_cell_centre(l, d->i0 + ca[q] / d->sub, d->j0 + cb[q] / d->sub,
+                                         ca[q] % d->sub, cb[q] % d->sub, d->sub);
                 if (map_separated(m, x, c, -1))
                     w[q] = 0;
                 sw += w[q];

@@ -146,6 +146,8 @@ static inline double axis_core_span(const map_axis *a)
 
 /* The point at (s, t) of a planar layout. */
 vec3 map_point(const map_layout *l, double s, double t);
+/* The centre of fine cell (su, sv) of texel (i, j), its side cut in sub. */
+vec3 map_cell_centre(const map_layout *l, int i, int j, int su, int sv, int sub);
 
 /* Texel (i, j) of a planar layout as a polygon (4 corners, then clipped to
  * the surface); returns the corner count, under 3 when nothing is left. */

@@ -57,9 +57,9 @@ zone_quality zone_quality_for(const zt_scene *sc, int q)
     z.refine_sub = q >= 5 ? 4 : 0;
     z.refine_contrast = 0.25;
     /* Kinks too (triangletest's level 2 at quality 5: 1.42% -> 1.29%,
-     * Phase One 1.5-1.6x the CPU; its pixel (33, 29) had been 2.9% too bright, the
-     * floor of a valley where a receiver crosses another triangle's
-     * plane smoothed over). */
+     * Phase One 1.5-1.6x the CPU; its pixel (33, 29) had been 2.9% too
+     * bright, the floor of a valley where a receiver crosses another
+     * triangle's plane smoothed over). */
     z.refine_kink = 0.04;
     return z;
 }
