@@ -252,31 +252,6 @@ static double texel_growth(const part_map *m, int u, int j)
     return sqrt(fmax(1.0, fmax(gu, gv)));
 }
 
-/* Where texel (u, j) of a map is lit: its centre, or for a texel cut by
- * the surface's edge, the centroid of the part that exists. */
-static void texel_eval_point(const part_map *m, int u, int j, int side, vec3 *x, vec3 *n)
-{
-    const map_layout *l = &m->layout;
-    map_texel_point(l, u, j, x, n);
-    if (l->shape != SHAPE_SPHERE) {
-        const float *st = m->eval_st + 2 * (((size_t)side * l->nv + j) * l->nu + u);
-        *x = map_point(l, st[0], st[1]);
-    }
-    if (side)
-        *n = v3_scale(*n, -1);
-}
-
-/* Where the other half of a cut texel is lit. */
-static void texel_alt_point(const part_map *m, int u, int j, int side, vec3 *x, vec3 *n)
-{
-    const map_layout *l = &m->layout;
-    map_texel_point(l, u, j, x, n);
-    const float *st = m->alt_st + 2 * ((size_t)j * l->nu + u);
-    *x = map_point(l, st[0], st[1]);
-    if (side)
-        *n = v3_scale(*n, -1);
-}
-
 /* A texel whose centre is unreachable (under an object standing on the
  * surface) may still be partly lit: it then takes its value at the
  * reachable one of a 4 x 4 set of points inside it nearest their centroid.
@@ -409,7 +384,7 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
             int side = row / m->layout.nv, j = row % m->layout.nv;
             for (int u = 0; u < m->layout.nu; u++) {
                 vec3 x, n;
-                texel_eval_point(m, u, j, side, &x, &n);
+                map_texel_eval_point(m, u, j, side, &x, &n);
                 float w = m->cover[(size_t)j * m->layout.nu + u] <= 0
                               ? 0.0f
                               : texel_weight(&r->rs, i, x, n, dirs, f->q.gather);
@@ -423,8 +398,8 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                      * point, on its own side of the crossing (a rescued
                      * point may have moved over: then the texel is whole). */
                     vec3 xa, na;
-                    texel_alt_point(m, u, j, side, &xa, &na);
-                    texel_eval_point(m, u, j, side, &x, &n);
+                    map_texel_alt_point(m, u, j, side, &xa, &na);
+                    map_texel_eval_point(m, u, j, side, &x, &n);
                     const map_crossing *c = &m->cross[m->cut[k]];
                     int main_sign = v3_dot(c->n, x) - c->d > 0 ? 1 : -1;
                     m->alt_weight[(size_t)side * m->layout.nv * m->layout.nu + k] =
@@ -454,7 +429,7 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                 int side = row / m->layout.nv, j = row % m->layout.nv;
                 for (int u = 0; u < m->layout.nu; u++) {
                     vec3 x, n;
-                    texel_eval_point(m, u, j, side, &x, &n);
+                    map_texel_eval_point(m, u, j, side, &x, &n);
                     /* Texels off the reachable surface (outside the room,
                      * inside objects) are never read: no need to light them. */
                     int reachable = m->weight[0][((size_t)side * m->layout.nv + j) * m->layout.nu + u] > 0;
@@ -471,7 +446,7 @@ zt_status forest_build_maps(zone_forest *f, const zt_renderer *r, zt_error *err)
                         size_t ka = (size_t)side * m->layout.nv * m->layout.nu + k;
                         vec3 ea = v3(0, 0, 0);
                         if (m->alt_weight[ka] > 0) {
-                            texel_alt_point(m, u, j, side, &x, &n);
+                            map_texel_alt_point(m, u, j, side, &x, &n);
                             ea = level == f->sky_slot ? sky_texel(&t, f, x, n, dirs)
                                                       : texel_value(&t, f, i, level, x, n, dirs,
                                                                     f->q.theta * texel_growth(m, u, j));

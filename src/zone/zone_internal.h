@@ -57,6 +57,7 @@ typedef struct zone_quality {
                                more than this share */
     double refine_kink; /* or where the second difference exceeds this
                            share (0: not looked for) */
+    double refine_theta; /* fine cells' transfer piece size, in thetas */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;

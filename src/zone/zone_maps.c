@@ -117,6 +117,30 @@ void map_texel_point(const map_layout *l, int i, int j, vec3 *p, vec3 *n)
     *n = v3_normalize(v3_cross(l->du, l->dv));
 }
 
+/* For a texel cut by the surface's edge, eval_st holds the centroid of the
+ * part that exists. */
+void map_texel_eval_point(const part_map *m, int u, int j, int side, vec3 *x, vec3 *n)
+{
+    const map_layout *l = &m->layout;
+    map_texel_point(l, u, j, x, n);
+    if (l->shape != SHAPE_SPHERE) {
+        const float *st = m->eval_st + 2 * (((size_t)side * l->nv + j) * l->nu + u);
+        *x = map_point(l, st[0], st[1]);
+    }
+    if (side)
+        *n = v3_scale(*n, -1);
+}
+
+void map_texel_alt_point(const part_map *m, int u, int j, int side, vec3 *x, vec3 *n)
+{
+    const map_layout *l = &m->layout;
+    map_texel_point(l, u, j, x, n);
+    const float *st = m->alt_st + 2 * ((size_t)j * l->nu + u);
+    *x = map_point(l, st[0], st[1]);
+    if (side)
+        *n = v3_scale(*n, -1);
+}
+
 void map_coords(const map_layout *l, vec3 p, double *u, double *v)
 {
     if (l->shape == SHAPE_SPHERE) {

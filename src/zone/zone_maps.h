@@ -123,6 +123,14 @@ typedef struct part_map {
 /* Texel centre (i, j) of the layout as a point and the surface normal. */
 void map_texel_point(const map_layout *l, int i, int j, vec3 *p, vec3 *n);
 
+/* Where texel (u, j) of a map is lit on a side (the normal facing that
+ * side): its centre, or for a texel cut by the surface's edge a point of
+ * the part that exists (Phase One: planar maps read eval_st). */
+void map_texel_eval_point(const part_map *m, int u, int j, int side, vec3 *x, vec3 *n);
+
+/* Where the other half of a texel a crossing cuts is lit (Phase One). */
+void map_texel_alt_point(const part_map *m, int u, int j, int side, vec3 *x, vec3 *n);
+
 /* Edge i (0..n) of an axis as a fraction of its length. */
 static inline double axis_edge(const map_axis *a, int i) { return a->edge[i]; }
 

@@ -61,6 +61,12 @@ zone_quality zone_quality_for(const zt_scene *sc, int q)
      * bright, the floor of a valley where a receiver crosses another
      * triangle's plane smoothed over). */
     z.refine_kink = 0.04;
+    /* Fine cells with coarser pieces than the texels', measured against
+     * texels computed again at their size (refine.c).  At 2 theta a
+     * profile over triangletest's refined texels read 0.32% (RMS) from the
+     * transfer at theta, at 1.5 theta 0.21%, at theta 0.19% for twice the
+     * refinement's time (1.5: +25%). */
+    z.refine_theta = 1.5;
     return z;
 }
 
