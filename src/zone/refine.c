@@ -105,18 +105,19 @@ static void cell_point(const map_layout *l, int i, int j, int su, int sv, int su
         *n = v3_scale(*n, -1);
 }
 
-/* The texels of the window's box and its ring, the bilinear read of fine
- * cell centres leans on them, computed again with the cells' piece size
- * `theta` into a copy of the map (`same`, sharing all else).  A cell's
- * detail is then what that read misses of its exact value at the same
- * piece size: a coarser transfer's own error (smooth, mostly from the
- * light a piece's visible and hidden parts share) cancels instead of
- * landing in the detail.  Measuring the cells at 2 theta against texels at
- * theta left triangletest's level 2 about 1% dark over refined texels.
- * Returns 0 when out of memory. */
+/* The texels the bilinear read of the marked texels' fine cells leans on
+ * (those texels and a ring around), computed again with the cells' piece
+ * size `theta`, in a copy of the map (`same`, sharing all else).  A cell's
+ * detail is then what that read misses of its value at the same piece
+ * size, and the coarser transfer's own error, which is smooth (a piece
+ * sends its mean light, while the part a receiver sees of it is lit
+ * otherwise than the part hidden), cancels instead of entering the detail.
+ * Cells at 2 theta measured against the texels themselves (theta) left
+ * triangletest's level 2 about 1% dark over refined texels.  Returns 0
+ * when out of memory. */
 static int same_size_texels(zone_forest *f, const zt_renderer *r, int part, int level, int side,
-                            int i0, int j0, int i1, int j1, double theta, part_map *same,
-                            uint64_t *rays)
+                            const unsigned char *mark, int i0, int j0, int i1, int j1,
+                            double theta, part_map *same, uint64_t *rays)
 {
     const part_map *m = &f->maps[part];
     const map_layout *l = &m->layout;
@@ -142,6 +143,13 @@ static int same_size_texels(zone_forest *f, const zt_renderer *r, int part, int 
         zone_trace t = {f, r, 0, 0.0f};
         for (int i = i0; i <= i1; i++) {
             size_t k = (size_t)j * nu + i, ka = (size_t)side * nv * nu + k;
+            /* A cell's read leans on the texels around its own only. */
+            int near = 0;
+            for (int b = j - 1; b <= j + 1 && !near; b++)
+                for (int a = i - 1; a <= i + 1 && !near; a++)
+                    near = a >= 0 && b >= 0 && a < nu && b < nv && mark[(size_t)b * nu + a];
+            if (!near)
+                continue;
             vec3 x, n;
             if (m->weight[0][ka] > 0) {
                 map_texel_eval_point(m, i, j, side, &x, &n);
@@ -200,7 +208,7 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
      * map itself. */
     double theta = f->q.refine_theta * f->q.theta;
     part_map same = *m;
-    if (level > 0 && !same_size_texels(f, r, part, level, side, i0, j0, i1, j1, theta, &same, rays)) {
+    if (level > 0 && !same_size_texels(f, r, part, level, side, mark, i0, j0, i1, j1, theta, &same, rays)) {
         if (same.texels != m->texels)
             free(same.texels);
         if (same.alt != m->alt)
