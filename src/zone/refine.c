@@ -114,7 +114,7 @@ static void cell_point(const map_layout *l, int i, int j, int su, int sv, int su
  * otherwise than the part hidden), cancels instead of entering the detail.
  * Cells at 2 theta measured against the texels themselves (theta) left
  * triangletest's level 2 about 1% dark over refined texels.  Returns 0
- * when out of memory. */
+ * when out of memory (having freed what it took). */
 static int same_size_texels(zone_forest *f, const zt_renderer *r, int part, int level, int side,
                             const unsigned char *mark, int i0, int j0, int i1, int j1,
                             double theta, part_map *same, uint64_t *rays)
@@ -129,8 +129,11 @@ static int same_size_texels(zone_forest *f, const zt_renderer *r, int part, int 
     same->detail_live = 0;
     same->texels = malloc(total * sizeof(float));
     same->alt = m->alt ? malloc(total * sizeof(float)) : NULL;
-    if (!same->texels || (m->alt && !same->alt))
+    if (!same->texels || (m->alt && !same->alt)) {
+        free(same->texels);
+        free(same->alt);
         return 0;
+    }
     memcpy(same->texels, m->texels, total * sizeof(float));
     if (m->alt)
         memcpy(same->alt, m->alt, total * sizeof(float));
@@ -208,13 +211,8 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
      * map itself. */
     double theta = f->q.refine_theta * f->q.theta;
     part_map same = *m;
-    if (level > 0 && !same_size_texels(f, r, part, level, side, mark, i0, j0, i1, j1, theta, &same, rays)) {
-        if (same.texels != m->texels)
-            free(same.texels);
-        if (same.alt != m->alt)
-            free(same.alt);
+    if (level > 0 && !same_size_texels(f, r, part, level, side, mark, i0, j0, i1, j1, theta, &same, rays))
         return 0;
-    }
 #pragma omp parallel for schedule(dynamic, 1) num_threads(render_thread_count(r->options.threads)) reduction(+ : count)
     for (int b = 0; b < rows; b++) {
         zone_trace t = {f, r, 0, 0.0f};
