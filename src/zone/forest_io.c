@@ -369,9 +369,10 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
             w_i32(&w, d->sub);
             w_bytes(&w, d->use, (size_t)d->ni * d->nj);
             w_f32s(&w, d->e, detail_values(d));
-            /* A window with nothing outside its marks writes zeros there. */
-            for (size_t k2 = 0; k2 < (size_t)l->nu * l->nv * 3; k2++)
-                w_f32(&w, d->coarse ? d->coarse[k2] : 0.0f);
+            /* Texels read outside the marks: a caustic's only. */
+            w_i32(&w, d->coarse != NULL);
+            if (d->coarse)
+                w_f32s(&w, d->coarse, (size_t)l->nu * l->nv * 3);
         }
     }
     /* File size and checksum. */
@@ -499,14 +500,6 @@ static vec3 r_v3(rbuf *r)
 }
 
 /* n floats into a new array, or NULL (short read or no memory: *oom). */
-static int all_zero(const float *v, size_t n)
-{
-    for (size_t i = 0; i < n; i++)
-        if (v[i] != 0.0f)
-            return 0;
-    return 1;
-}
-
 static float *r_f32s(rbuf *r, size_t n, int *oom)
 {
     if (r->short_read || n > (r->n - r->at) / 4) {
@@ -704,7 +697,7 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
         int details = r_i32(rb);
         if (rb->short_read)
             return ZT_ERR_PARSE;
-        if (details < 0 || details > 4 * f->map_levels || (details && l->shape == SHAPE_SPHERE))
+        if (details < 0 || details > 2 * f->map_levels * (2 + 2 * m->crossings) || (details && l->shape == SHAPE_SPHERE))
             return corrupt(err, path, "bad detail window count");
         m->detail = calloc((size_t)details + 1, sizeof(map_detail));
         if (!m->detail)
@@ -739,12 +732,13 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
                     return corrupt(err, path, "bad detail window");
             }
             d->e = r_f32s(rb, detail_values(d), &oom);
-            if (d->e)
+            int has_coarse = r_i32(rb);
+            if (rb->short_read)
+                return ZT_ERR_PARSE;
+            if (has_coarse != 0 && has_coarse != 1)
+                return corrupt(err, path, "bad detail window");
+            if (d->e && has_coarse)
                 d->coarse = r_f32s(rb, (size_t)l->nu * l->nv * 3, &oom);
-            if (d->coarse && all_zero(d->coarse, (size_t)l->nu * l->nv * 3)) {
-                free(d->coarse); /* as the window was built: nothing outside */
-                d->coarse = NULL;
-            }
             if (oom)
                 return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
             if (rb->short_read)

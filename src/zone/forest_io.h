@@ -10,7 +10,7 @@
 /* 8: the layout of 7; its quality-5 windows follow new rules (kinks
  * refined, fine cells read apart across crossings), so a forest of 7
  * would not render what a build of 8 would. */
-#define FOREST_FILE_VERSION 9
+#define FOREST_FILE_VERSION 10
 
 /* Writes f (the forest of renderer r) to path, through a temporary file
  * renamed into place. */

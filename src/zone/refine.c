@@ -94,6 +94,32 @@ static int mark_rough(const part_map *m, int level, int side, double contrast, d
     return count;
 }
 
+/* Marks (in `ends`, cleared first) the texels of `mark` around end e (0:
+ * a, 1: b) of crossing k, the texel holding it and its eight neighbours,
+ * that `taken` does not hold yet, and adds them to `taken`.  Returns how
+ * many. */
+static int mark_end(const part_map *m, int k, int e, const unsigned char *mark,
+                    unsigned char *taken, unsigned char *ends)
+{
+    const map_layout *l = &m->layout;
+    int nu = l->nu, nv = l->nv, count = 0;
+    memset(ends, 0, (size_t)nu * nv);
+    double u, v;
+    map_coords(l, e ? m->cross[k].b : m->cross[k].a, &u, &v);
+    int ic = (int)floor(u + 0.5), jc = (int)floor(v + 0.5);
+    for (int j = jc - 1; j <= jc + 1; j++)
+        for (int i = ic - 1; i <= ic + 1; i++) {
+            if (i < 0 || j < 0 || i >= nu || j >= nv)
+                continue;
+            size_t t = (size_t)j * nu + i;
+            if (mark[t] && !taken[t]) {
+                ends[t] = taken[t] = 1;
+                count++;
+            }
+        }
+    return count;
+}
+
 /* The centre of fine cell (su, sv) of texel (i, j), its side's normal. */
 static void cell_point(const map_layout *l, int i, int j, int su, int sv, int sub, int side,
                        vec3 *x, vec3 *n)
@@ -173,14 +199,17 @@ static int same_size_texels(zone_forest *f, const zt_renderer *r, int part, int 
     return 1;
 }
 
-/* One window: the box of the marked texels, its cells filled. */
-static int refine_window(zone_forest *f, const zt_renderer *r, int part, int level, int side,
-                         const unsigned char *mark, uint64_t *rays)
+/* A new window over the box of the marked texels, `sub` cells a side,
+ * zeroed, at level -1 while its cells are filled (so that reads, on other
+ * threads too, leave it out).  NULL when none is marked or out of memory
+ * (*failed says which). */
+static map_detail *add_window(part_map *m, int side, const unsigned char *mark, int sub,
+                              int *failed)
 {
-    part_map *m = &f->maps[part];
     const map_layout *l = &m->layout;
-    int nu = l->nu, nv = l->nv, sub = f->q.refine_sub;
+    int nu = l->nu, nv = l->nv;
     int i0 = nu, i1 = -1, j0 = nv, j1 = -1;
+    *failed = 0;
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++)
             if (mark[(size_t)j * nu + i]) {
@@ -188,58 +217,109 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
                 j0 = j < j0 ? j : j0, j1 = j > j1 ? j : j1;
             }
     if (i1 < 0)
-        return 1;
+        return NULL;
     int ni = i1 - i0 + 1, nj = j1 - j0 + 1;
+    *failed = 1;
     map_detail *nd = realloc(m->detail, (size_t)(m->details + 1) * sizeof *nd);
     if (!nd)
-        return 0;
+        return NULL;
     m->detail = nd;
     map_detail *d = &m->detail[m->details++];
-    /* Level -1 while its cells are filled, so that the reads below (on
-     * other threads too) leave it out. */
     *d = (map_detail){-1, side, i0, j0, ni, nj, sub, NULL, NULL, NULL};
     d->use = malloc((size_t)ni * nj);
     d->e = calloc((size_t)ni * nj * sub * sub * 3, sizeof(float));
     if (!d->use || !d->e)
-        return 0;
+        return NULL;
     for (int j = 0; j < nj; j++)
         for (int i = 0; i < ni; i++)
             d->use[(size_t)j * ni + i] = mark[(size_t)(j0 + j) * nu + i0 + i];
-    int fu = ni * sub, rows = nj * sub;
+    *failed = 0;
+    return d;
+}
+
+/* Window d's cells in its marked texels: the exact irradiance (E_0 as
+ * its texels are, higher levels by the transfer at `theta`) less what
+ * `read` (the map the cells complete) gives there. */
+static void fill_cells(zone_forest *f, const zt_renderer *r, int part, int level, int side,
+                       map_detail *d, const part_map *read, double theta, uint64_t *rays)
+{
+    const map_layout *l = &f->maps[part].layout;
+    int sub = d->sub, fu = d->ni * sub, rows = d->nj * sub;
     uint64_t count = 0;
-    /* E_0's cells are exact, as its texels are: they are read against the
-     * map itself. */
-    double theta = f->q.refine_theta * f->q.theta;
-    part_map same = *m;
-    if (level > 0 && !same_size_texels(f, r, part, level, side, mark, i0, j0, i1, j1, theta, &same, rays))
-        return 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(render_thread_count(r->options.threads)) reduction(+ : count)
     for (int b = 0; b < rows; b++) {
         zone_trace t = {f, r, 0, 0.0f};
-        int j = j0 + b / sub, sv = b % sub;
+        int j = d->j0 + b / sub, sv = b % sub;
         for (int a = 0; a < fu; a++) {
-            int i = i0 + a / sub, su = a % sub;
-            if (!mark[(size_t)j * nu + i])
+            int i = d->i0 + a / sub, su = a % sub;
+            if (!d->use[(size_t)(b / sub) * d->ni + a / sub])
                 continue;
             vec3 x, n;
             cell_point(l, i, j, su, sv, sub, side, &x, &n);
             vec3 exact = level == 0 ? forest_direct_at(&t, part, x, n)
                                     : transfer_irradiance(&t, part, x, n, level, theta);
-            vec3 read = map_lookup_wide(&same, level, side, x, 0.0);
+            vec3 got = map_lookup_wide(read, level, side, x, 0.0);
             float *e = d->e + 3 * ((size_t)b * fu + a);
-            e[0] = (float)(exact.x - read.x);
-            e[1] = (float)(exact.y - read.y);
-            e[2] = (float)(exact.z - read.z);
+            e[0] = (float)(exact.x - got.x);
+            e[1] = (float)(exact.y - got.y);
+            e[2] = (float)(exact.z - got.z);
         }
         count += t.rays;
+    }
+    *rays += count;
+}
+
+/* The windows of one level and side: the marked texels' cells, then (from
+ * the quality that asks for them) finer cells around the ends of
+ * crossings. */
+static int refine_window(zone_forest *f, const zt_renderer *r, int part, int level, int side,
+                         const unsigned char *mark, uint64_t *rays)
+{
+    part_map *m = &f->maps[part];
+    int failed;
+    map_detail *d = add_window(m, side, mark, f->q.refine_sub, &failed);
+    if (!d)
+        return !failed;
+    /* E_0's cells are exact, as its texels are: they are read against the
+     * map itself. */
+    double theta = f->q.refine_theta * f->q.theta;
+    part_map same = *m;
+    same.details = 0;
+    same.detail_live = 0;
+    if (level > 0 && !same_size_texels(f, r, part, level, side, mark, d->i0, d->j0,
+                                       d->i0 + d->ni - 1, d->j0 + d->nj - 1, theta, &same, rays))
+        return 0;
+    fill_cells(f, r, part, level, side, d, &same, theta, rays);
+    d->level = level;
+    /* Then a window of finer cells around each end of a crossing (ends
+     * close together share texels: each texel goes to the first), which
+     * complete the read with the windows before them. */
+    int ok = 1;
+    if (f->q.refine_end_sub > f->q.refine_sub && m->crossings > 0) {
+        size_t cells = (size_t)m->layout.nu * m->layout.nv;
+        unsigned char *taken = calloc(cells * 2, 1), *ends = taken + cells;
+        ok = taken != NULL;
+        for (int k = 0; ok && k < m->crossings; k++)
+            for (int e = 0; ok && e < 2; e++) {
+                if (!mark_end(m, k, e, mark, taken, ends))
+                    continue;
+                map_detail *d2 = add_window(m, side, ends, f->q.refine_end_sub, &failed);
+                ok = !failed;
+                if (!d2)
+                    continue;
+                same.detail = m->detail;
+                same.details = m->details;
+                same.detail_live = 1;
+                fill_cells(f, r, part, level, side, d2, &same, theta, rays);
+                d2->level = level;
+            }
+        free(taken);
     }
     if (level > 0) {
         free(same.texels);
         free(same.alt);
     }
-    d->level = level;
-    *rays += count;
-    return 1;
+    return ok;
 }
 
 int refine_level(zone_forest *f, const zt_renderer *r, int level)

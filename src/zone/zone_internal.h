@@ -58,6 +58,8 @@ typedef struct zone_quality {
     double refine_kink; /* or where the second difference exceeds this
                            share (0: not looked for) */
     double refine_theta; /* fine cells' transfer piece size, in thetas */
+    int refine_end_sub; /* finer cells per texel side around the ends of
+                           crossings (0: none; refine.c) */
 } zone_quality;
 
 typedef struct transfer_blockers transfer_blockers;
