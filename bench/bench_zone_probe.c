@@ -34,7 +34,6 @@
 #include "geom/ray_offset.h"
 #include "render/render_internal.h"
 #include "util/vec3_convert.h"
-#include "zone/direct.h"
 #include "zone/zone_internal.h"
 #include "zonetrace/zonetrace.h"
 
@@ -91,15 +90,8 @@ static vec3 diffuse_albedo(const probe *p, int part)
 static vec3 direct_light(const probe *p, int part, vec3 y, vec3 n, uint64_t *s)
 {
     const rscene *rs = &p->r->rs;
-    vec3 e = v3(0, 0, 0);
-    for (int i = 0; i < rs->part_count; i++) {
-        const rs_part *lp = &rs->parts[i];
-        if (!lp->is_light || f3_is_black(rs->objects[lp->object].emission))
-            continue;
-        vec3f em = rs->objects[lp->object].emission;
-        double g = direct_irradiance(&p->f->direct, i, y, n, part);
-        e = v3_add(e, v3_scale(v3(em.x, em.y, em.z), g));
-    }
+    zone_trace t = {p->f, p->r, 0, 0.0f};
+    vec3 e = forest_lights_at(&t, part, y, n);
     vec3 d = cosine_direction(n, s);
     hit h = accel_intersect(rs, ray_offset(v3_to_f3(y), v3_to_f3(n)), v3_to_f3(d));
     if (h.part < 0)

@@ -107,8 +107,7 @@ static void frame(vec3 n, vec3 *t, vec3 *b)
 }
 
 
-/* Direct irradiance (every light, exact) at point x of a part. */
-static vec3 direct_light_at(zone_trace *t, int part_index, vec3 x, vec3 n)
+vec3 forest_lights_at(zone_trace *t, int part_index, vec3 x, vec3 n)
 {
     const rscene *rs = &t->r->rs;
     vec3 e = v3(0, 0, 0);
@@ -130,7 +129,7 @@ static vec3 texel_value(zone_trace *t, const zone_forest *f, int part_index, int
     const rscene *rs = &t->r->rs;
     vec3 e = v3(0, 0, 0);
     if (level == 0) {
-        e = direct_light_at(t, part_index, x, n);
+        e = forest_lights_at(t, part_index, x, n);
         if (f3_is_black(rs->sky))
             return e;
     } else {
@@ -226,7 +225,7 @@ static vec3 sky_texel(zone_trace *t, const zone_forest *f, vec3 x, vec3 n, const
 
 vec3 forest_direct_at(zone_trace *t, int part_index, vec3 x, vec3 n)
 {
-    vec3 e = direct_light_at(t, part_index, x, n);
+    vec3 e = forest_lights_at(t, part_index, x, n);
     if (t->f->sky_slot >= 0)
         e = v3_add(e, sky_texel(t, t->f, x, n, t->f->dirs));
     return e;

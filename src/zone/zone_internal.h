@@ -119,6 +119,10 @@ vec3 forest_sky_irradiance(zone_trace *t, vec3 x, vec3 n);
  * light exactly, plus the sky by the gather directions. */
 vec3 forest_direct_at(zone_trace *t, int part_index, vec3 x, vec3 n);
 
+/* The direct irradiance of every light part (exact, direct.c) at x
+ * (normal n) on a part, without the sky's. */
+vec3 forest_lights_at(zone_trace *t, int part_index, vec3 x, vec3 n);
+
 enum {
     ZR_EXACT_DIRECT = 1, /* level 1 from the analytic direct term, not maps */
     ZR_NO_EMISSION = 2,  /* lights hit by this very ray count nothing (the
