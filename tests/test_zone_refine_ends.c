@@ -62,10 +62,8 @@ static const vec3 end_p = {0.3, 0, 0.9};
 static const vec3 face_n = {-1, 0, 0};
 static const vec3 up = {0, 1, 0}, along = {0, 0, -1};
 
-#define MATERIAL "\"material\": {\"character\": {\"diffuse\": 1, \"metallic\": 0, " \
-    "\"reflecting\": 0, \"refractive\": 0}, \"color\": [%g, %g, %g]}"
 #define TRIANGLE "{\"triangle\": {\"points\": [[%g, %g, %g], [%g, %g, %g], [%g, %g, %g]], " \
-    "\"backculled\": false, " MATERIAL "}}"
+    "\"backculled\": false, " TEST_DIFFUSE_FMT "}}"
 #define POINTS(t) t[0].x, t[0].y, t[0].z, t[1].x, t[1].y, t[1].z, t[2].x, t[2].y, t[2].z
 #define GREY(a) a, a, a
 

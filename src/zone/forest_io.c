@@ -697,7 +697,10 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
         int details = r_i32(rb);
         if (rb->short_read)
             return ZT_ERR_PARSE;
-        if (details < 0 || details > 2 * f->map_levels * (2 + 2 * m->crossings) || (details && l->shape == SHAPE_SPHERE))
+        /* Per level and side: a caustic's window, the refinement's, and
+         * one around each end of each crossing. */
+        int most = 2 * f->map_levels * (2 + 2 * m->crossings);
+        if (details < 0 || details > most || (details && l->shape == SHAPE_SPHERE))
             return corrupt(err, path, "bad detail window count");
         m->detail = calloc((size_t)details + 1, sizeof(map_detail));
         if (!m->detail)

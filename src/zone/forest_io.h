@@ -9,7 +9,10 @@
 
 /* 8: the layout of 7; its quality-5 windows follow new rules (kinks
  * refined, fine cells read apart across crossings), so a forest of 7
- * would not render what a build of 8 would. */
+ * would not render what a build of 8 would.  9: the same layout, fine
+ * cells measured against texels made at their own piece size.  10:
+ * windows around the ends of crossings, and a window's coarse texels
+ * stored only after a flag (docs/zone-tracer.md). */
 #define FOREST_FILE_VERSION 10
 
 /* Writes f (the forest of renderer r) to path, through a temporary file

@@ -12,6 +12,14 @@
 #include "zonetrace/render.h"
 #include "zonetrace/scene.h"
 
+/* A scene file's "material" member for a grey diffuse surface: albedo a
+ * written as a literal (TEST_DIFFUSE(0.5)), or left to printf as three %g
+ * (TEST_DIFFUSE_FMT). */
+#define TEST_DIFFUSE_HEAD "\"material\": {\"character\": {\"diffuse\": 1, \"metallic\": 0, " \
+    "\"reflecting\": 0, \"refractive\": 0}, \"color\": ["
+#define TEST_DIFFUSE(a) TEST_DIFFUSE_HEAD #a ", " #a ", " #a "]}"
+#define TEST_DIFFUSE_FMT TEST_DIFFUSE_HEAD "%g, %g, %g]}"
+
 /* The ../shared folder beside the clone, or NULL (with a message on stderr
  * saying the test is skipped) when it is absent. */
 const char *test_shared_dir(void);
