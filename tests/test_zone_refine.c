@@ -127,8 +127,9 @@ static void test_refined_read_follows_crossing(void **state)
         }
     printf("mean relative error: quality 4 %.4f, quality 5 refined %.4f (max %.4f)\n",
            sum_plain / n, sum_refined / n, max_refined);
-    /* Measured: quality 4 4.6%; quality 5 0.43% (max 1.3%) with the end
-     * windows, 0.45% before them; 0.43% with fine cells at 2 theta
+    /* Measured: quality 4 4.6%; quality 5 0.51% (max 1.3%) with split
+     * cells, 0.43% (max 1.3%) before them with the end windows, 0.45%
+     * before those; 0.43% with fine cells at 2 theta
      * against texels at theta; 0.50% (max 1.6%)
      * before kinks were refined and fine cells read apart across the
      * crossing; 1.2% (max 4.1%) when the transfer sent texel means even

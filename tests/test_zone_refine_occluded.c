@@ -127,8 +127,8 @@ static void test_refined_read_unbiased_under_occluder(void **state)
     }
     printf("relative error over %d refined reads: signed mean %+.4f, mean %.4f, max %.4f\n", n,
            sum / n, sum_abs / n, max_abs);
-    /* Measured: signed mean -1.5%, mean 1.5%, max 5.0% (max 5.9% before
-     * the windows around crossings' ends); -6.6%, 6.6%, max
+    /* Measured: signed mean -1.5%, mean 1.5%, max 4.1% (max 5.0% before
+     * split cells, 5.9% before the windows around crossings' ends); -6.6%, 6.6%, max
      * 11.0% with fine cells at 2 theta measured against texels at theta
      * (before 9867730), -1.2% with cells at 2 theta measured against
      * texels made again at 2 theta.  Without C: -0.1%, 0.5% (before:

@@ -514,7 +514,8 @@ static int make_details(zone_forest *f, int p, const double *acc, const double *
             }
             m->detail = nd;
             map_detail *d = &m->detail[m->details++];
-            *d = (map_detail){level, side, i0, j0, ni, nj, DETAIL_SUB, NULL, NULL, NULL};
+            *d = (map_detail){level, side, i0, j0, ni, nj, DETAIL_SUB,
+                              NULL, NULL, NULL, NULL, NULL};
             d->use = malloc((size_t)ni * nj);
             d->e = calloc((size_t)ni * nj * DETAIL_SUB * DETAIL_SUB * 3, sizeof(float));
             d->coarse = malloc(cells * 3 * sizeof(float));

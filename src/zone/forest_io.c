@@ -250,6 +250,16 @@ static size_t detail_values(const map_detail *d)
     return (size_t)d->ni * d->sub * d->nj * d->sub * 3;
 }
 
+/* A loaded cell may be split only inside a used texel a crossing cuts
+ * (the read looks up that crossing). */
+static int split_allowed(const part_map *m, const map_detail *d, size_t cell)
+{
+    size_t row = (size_t)d->ni * d->sub;
+    int i = (int)(cell % row) / d->sub, j = (int)(cell / row) / d->sub;
+    return d->use[(size_t)j * d->ni + i] &&
+           m->cut[(size_t)(d->j0 + j) * m->layout.nu + d->i0 + i] >= 0;
+}
+
 static void w_axis(wbuf *w, const map_axis *a)
 {
     w_i32(w, a->n);
@@ -373,6 +383,12 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
             w_i32(&w, d->coarse != NULL);
             if (d->coarse)
                 w_f32s(&w, d->coarse, (size_t)l->nu * l->nv * 3);
+            /* Refinement cells split by a crossing. */
+            w_i32(&w, d->split != NULL);
+            if (d->split) {
+                w_bytes(&w, d->split, detail_values(d) / 3);
+                w_f32s(&w, d->far, detail_values(d) * 2);
+            }
         }
     }
     /* File size and checksum. */
@@ -742,6 +758,28 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
                 return corrupt(err, path, "bad detail window");
             if (d->e && has_coarse)
                 d->coarse = r_f32s(rb, (size_t)l->nu * l->nv * 3, &oom);
+            int has_split = r_i32(rb);
+            if (rb->short_read)
+                return ZT_ERR_PARSE;
+            if ((has_split != 0 && has_split != 1) || (has_split && (d->coarse || !m->crossings)))
+                return corrupt(err, path, "bad detail window");
+            if (d->e && has_split) {
+                size_t ncell = detail_values(d) / 3;
+                if (ncell > rb->n - rb->at) {
+                    rb->short_read = 1;
+                    return ZT_ERR_PARSE;
+                }
+                d->split = malloc(ncell);
+                if (!d->split)
+                    return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+                for (size_t c = 0; c < ncell; c++) {
+                    d->split[c] = rb->b[rb->at++];
+                    if (d->split[c] > 1 ||
+                        (d->split[c] && !split_allowed(m, d, c)))
+                        return corrupt(err, path, "bad detail window");
+                }
+                d->far = r_f32s(rb, ncell * 6, &oom);
+            }
             if (oom)
                 return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
             if (rb->short_read)
@@ -967,7 +1005,7 @@ void forest_memory(const zone_forest *f, uint64_t *zones, uint64_t *occluders, u
                   (size_t)m->crossings * sizeof *m->cross;
         for (int k = 0; k < m->details; k++)
             mb += sizeof(map_detail) + (size_t)m->detail[k].ni * m->detail[k].nj +
-                  (detail_values(&m->detail[k]) +
+                  (detail_values(&m->detail[k]) * (m->detail[k].split ? 3 : 1) +
                    (m->detail[k].coarse ? mip_values(m, 0) / m->levels / m->layout.sides : 0)) *
                       sizeof(float);
     }

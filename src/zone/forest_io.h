@@ -13,7 +13,7 @@
  * cells measured against texels made at their own piece size.  10:
  * windows around the ends of crossings, and a window's coarse texels
  * stored only after a flag (docs/zone-tracer.md). */
-#define FOREST_FILE_VERSION 10
+#define FOREST_FILE_VERSION 11
 
 /* Writes f (the forest of renderer r) to path, through a temporary file
  * renamed into place. */

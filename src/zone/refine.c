@@ -225,7 +225,7 @@ static map_detail *add_window(part_map *m, int side, const unsigned char *mark, 
         return NULL;
     m->detail = nd;
     map_detail *d = &m->detail[m->details++];
-    *d = (map_detail){-1, side, i0, j0, ni, nj, sub, NULL, NULL, NULL};
+    *d = (map_detail){-1, side, i0, j0, ni, nj, sub, NULL, NULL, NULL, NULL, NULL};
     d->use = malloc((size_t)ni * nj);
     d->e = calloc((size_t)ni * nj * sub * sub * 3, sizeof(float));
     if (!d->use || !d->e)
@@ -239,12 +239,29 @@ static map_detail *add_window(part_map *m, int side, const unsigned char *mark, 
 
 /* Window d's cells in its marked texels: the exact irradiance (E_0 as
  * its texels are, higher levels by the transfer at `theta`) less what
- * `read` (the map the cells complete) gives there. */
-static void fill_cells(zone_forest *f, const zt_renderer *r, int part, int level, int side,
-                       map_detail *d, const part_map *read, double theta, uint64_t *rays)
+ * `read` (the map the cells complete) gives there.  A cell a crossing
+ * passes through gets a second value, the same at its part beyond the
+ * crossing: the light jumps there, and beside a crossing's end the cells
+ * on the far side, which a read would take instead, lie further off while
+ * the light changes fastest.  Returns 0 when out of memory. */
+static int fill_cells(zone_forest *f, const zt_renderer *r, int part, int level, int side,
+                      map_detail *d, const part_map *read, double theta, uint64_t *rays)
 {
-    const map_layout *l = &f->maps[part].layout;
+    const part_map *m = &f->maps[part];
+    const map_layout *l = &m->layout;
     int sub = d->sub, fu = d->ni * sub, rows = d->nj * sub;
+    size_t cells = (size_t)fu * rows;
+    int any_cut = 0;
+    for (int j = 0; j < d->nj && m->crossings; j++)
+        for (int i = 0; i < d->ni; i++)
+            any_cut |= d->use[(size_t)j * d->ni + i] &&
+                       m->cut[(size_t)(d->j0 + j) * l->nu + d->i0 + i] >= 0;
+    if (any_cut) {
+        d->split = calloc(cells, 1);
+        d->far = calloc(cells * 6, sizeof(float));
+        if (!d->split || !d->far)
+            return 0;
+    }
     uint64_t count = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(render_thread_count(r->options.threads)) reduction(+ : count)
     for (int b = 0; b < rows; b++) {
@@ -263,10 +280,23 @@ static void fill_cells(zone_forest *f, const zt_renderer *r, int part, int level
             e[0] = (float)(exact.x - got.x);
             e[1] = (float)(exact.y - got.y);
             e[2] = (float)(exact.z - got.z);
+            vec3 y;
+            if (!d->split || !map_cell_split(m, i, j, su, sv, sub, &y))
+                continue;
+            exact = level == 0 ? forest_direct_at(&t, part, y, n)
+                               : transfer_irradiance(&t, part, y, n, level, theta);
+            got = map_lookup_wide(read, level, side, y, 0.0);
+            float *g = d->far + 6 * ((size_t)b * fu + a);
+            g[0] = (float)(exact.x - got.x);
+            g[1] = (float)(exact.y - got.y);
+            g[2] = (float)(exact.z - got.z);
+            g[3] = (float)y.x, g[4] = (float)y.y, g[5] = (float)y.z;
+            d->split[(size_t)b * fu + a] = 1;
         }
         count += t.rays;
     }
     *rays += count;
+    return 1;
 }
 
 /* The windows of one level and side: the marked texels' cells, then (from
@@ -289,13 +319,12 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
     if (level > 0 && !same_size_texels(f, r, part, level, side, mark, d->i0, d->j0,
                                        d->i0 + d->ni - 1, d->j0 + d->nj - 1, theta, &same, rays))
         return 0;
-    fill_cells(f, r, part, level, side, d, &same, theta, rays);
+    int ok = fill_cells(f, r, part, level, side, d, &same, theta, rays);
     d->level = level;
     /* Then a window of finer cells around each end of a crossing (ends
      * close together share texels: each texel goes to the first), which
      * complete the read with the windows before them. */
-    int ok = 1;
-    if (f->q.refine_end_sub > f->q.refine_sub && m->crossings > 0) {
+    if (ok && f->q.refine_end_sub > f->q.refine_sub && m->crossings > 0) {
         size_t cells = (size_t)m->layout.nu * m->layout.nv;
         unsigned char *taken = calloc(cells * 2, 1), *ends = taken + cells;
         ok = taken != NULL;
@@ -310,7 +339,7 @@ static int refine_window(zone_forest *f, const zt_renderer *r, int part, int lev
                 same.detail = m->detail;
                 same.details = m->details;
                 same.detail_live = 1;
-                fill_cells(f, r, part, level, side, d2, &same, theta, rays);
+                ok = fill_cells(f, r, part, level, side, d2, &same, theta, rays);
                 d2->level = level;
             }
         free(taken);
@@ -359,6 +388,8 @@ void refine_drop_level0(zone_forest *f)
             if (d->level == 0 && !d->coarse) {
                 free(d->use);
                 free(d->e);
+                free(d->split);
+                free(d->far);
                 continue;
             }
             m->detail[kept++] = *d;

@@ -305,6 +305,31 @@ static int segment_meets(const map_crossing *c, const vec3 *q, int n, vec3 nrm, 
     return t1 - t0 > 1e-9;
 }
 
+int map_cell_split(const part_map *m, int i, int j, int su, int sv, int sub, vec3 *far)
+{
+    const map_layout *l = &m->layout;
+    if (!m->crossings || m->cut[(size_t)j * l->nu + i] < 0)
+        return 0;
+    const map_crossing *x = &m->cross[m->cut[(size_t)j * l->nu + i]];
+    double s0 = axis_edge(&l->au, i), s1 = axis_edge(&l->au, i + 1);
+    double t0 = axis_edge(&l->av, j), t1 = axis_edge(&l->av, j + 1);
+    double ds = (s1 - s0) / sub, dt = (t1 - t0) / sub;
+    enum { QMAX = 2 * MAP_CLIPS + 8 };
+    vec3 q[QMAX], cen;
+    int n = map_rect_polygon(l, s0 + su * ds, s0 + (su + 1) * ds, t0 + sv * dt,
+                             t0 + (sv + 1) * dt, q, QMAX);
+    if (n < 3)
+        return 0;
+    double whole = poly3_area(q, n, &cen);
+    if (!segment_meets(x, q, n, v3_normalize(v3_cross(l->du, l->dv)), cen))
+        return 0;
+    /* The part on the other side of the crossing's plane from the centre. */
+    vec3 centre = map_cell_centre(l, i, j, su, sv, sub);
+    double sign = crossing_side(x, centre) > 0 ? -1.0 : 1.0;
+    int nf = poly3_clip(q, n, QMAX, v3_scale(x->n, sign), -sign * x->d);
+    return nf >= 3 && poly3_area(q, nf, far) > 1e-4 * whole;
+}
+
 int map_build_cuts(part_map *m)
 {
     const map_layout *l = &m->layout;
@@ -499,7 +524,8 @@ static vec3 bilinear(const part_map *m, int k, int level, int side, double s, do
 /* Bilinear between fine cell centres (held at the window's edge cells).
  * Where a crossing passes among the four cells, those it separates from x
  * (the point read) do not take part: the light jumps there, and the
- * cells on the far side hold what the read misses over there. */
+ * cells on the far side hold what the read misses over there.  A cell the
+ * crossing passes through stands for x's side by its part there. */
 static vec3 fine_read(const part_map *m, const map_detail *d, double U, double V, vec3 x)
 {
     int nu = d->ni * d->sub, nv = d->nj * d->sub;
@@ -510,6 +536,9 @@ static vec3 fine_read(const part_map *m, const map_detail *d, double U, double V
     double fx = fu - a, fy = fv - b;
     int ca[4] = {a, a1, a, a1}, cb[4] = {b, b, b1, b1};
     double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+    const float *val[4];
+    for (int q = 0; q < 4; q++)
+        val[q] = d->e + ((size_t)cb[q] * nu + ca[q]) * 3;
     if (m->crossings > 0) {
         /* Only texels a crossing cuts can hold cells it separates. */
         const map_layout *l = &m->layout;
@@ -524,8 +553,17 @@ static vec3 fine_read(const part_map *m, const map_detail *d, double U, double V
         if (cut) {
             double sw = 0;
             for (int q = 0; q < 4; q++) {
-                vec3 c = map_cell_centre(l, d->i0 + ca[q] / d->sub, d->j0 + cb[q] / d->sub,
-                                         ca[q] % d->sub, cb[q] % d->sub, d->sub);
+                int i = d->i0 + ca[q] / d->sub, j = d->j0 + cb[q] / d->sub;
+                vec3 c = map_cell_centre(l, i, j, ca[q] % d->sub, cb[q] % d->sub, d->sub);
+                size_t cell = (size_t)cb[q] * nu + ca[q];
+                if (d->split && d->split[cell]) {
+                    const map_crossing *xc = &m->cross[m->cut[(size_t)j * l->nu + i]];
+                    if ((crossing_side(xc, x) > 0) != (crossing_side(xc, c) > 0)) {
+                        const float *f = d->far + 6 * cell;
+                        c = v3(f[3], f[4], f[5]);
+                        val[q] = f;
+                    }
+                }
                 if (map_separated(m, x, c, -1))
                     w[q] = 0;
                 sw += w[q];
@@ -538,7 +576,7 @@ static vec3 fine_read(const part_map *m, const map_detail *d, double U, double V
     }
     vec3 r = v3(0, 0, 0);
     for (int q = 0; q < 4; q++) {
-        const float *e = d->e + ((size_t)cb[q] * nu + ca[q]) * 3;
+        const float *e = val[q];
         r = v3_add(r, v3(w[q] * e[0], w[q] * e[1], w[q] * e[2]));
     }
     return r;
@@ -689,6 +727,8 @@ void map_free(part_map *m)
         free(m->detail[k].use);
         free(m->detail[k].e);
         free(m->detail[k].coarse);
+        free(m->detail[k].split);
+        free(m->detail[k].far);
     }
     free(m->detail);
     free(m->layout.au.edge);

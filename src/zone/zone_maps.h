@@ -78,6 +78,12 @@ typedef struct map_detail {
     float *coarse;      /* the caustic per texel of the whole map [nv][nu][rgb],
                            in the texels too until caustic_finish takes it out;
                            NULL where nothing is read outside the marks */
+    /* Refinement only: cells a crossing passes through hold a second
+     * value, for their part on the far side of it from the cell centre.
+     * split[cell] is 1 there; far[cell] is that value (rgb) and the part's
+     * centroid (xyz).  NULL when no cell is split. */
+    unsigned char *split;
+    float *far;         /* [nj*sub][ni*sub][6] */
 } map_detail;
 
 /* The grid of one part: texel values for each level and side, and coarser
@@ -119,6 +125,11 @@ typedef struct part_map {
     map_detail *detail; /* caustics apart; read once detail_live */
     int details, detail_live;
 } part_map;
+
+/* Whether the crossing cutting texel (i, j) passes through its fine cell
+ * (su, sv) of `sub` a side; if so, *far is the centroid of the cell's part
+ * on the far side of it from the cell centre. */
+int map_cell_split(const part_map *m, int i, int j, int su, int sv, int sub, vec3 *far);
 
 /* Texel centre (i, j) of the layout as a point and the surface normal. */
 void map_texel_point(const map_layout *l, int i, int j, vec3 *p, vec3 *n);
