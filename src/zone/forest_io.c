@@ -532,6 +532,25 @@ static float *r_f32s(rbuf *r, size_t n, int *oom)
     return v;
 }
 
+/* n flags (bytes 0 or 1) into a new array, or NULL (short read, no memory:
+ * *oom); *bad is set when one is neither. */
+static unsigned char *r_flags(rbuf *r, size_t n, int *oom, int *bad)
+{
+    const unsigned char *p = r_take(r, n);
+    if (!p)
+        return NULL;
+    unsigned char *v = malloc(n ? n : 1);
+    if (!v) {
+        *oom = 1;
+        return NULL;
+    }
+    for (size_t i = 0; i < n; i++) {
+        v[i] = p[i];
+        *bad |= v[i] > 1;
+    }
+    return v;
+}
+
 static zt_status corrupt(zt_error *err, const char *path, const char *why)
 {
     return zt_fail(err, ZT_ERR_PARSE, "forest file '%s' is corrupt: %s", path, why);
@@ -737,19 +756,14 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
                 d->i0 < 0 || d->ni < 1 || d->ni > l->nu - d->i0 || d->j0 < 0 || d->nj < 1 ||
                 d->nj > l->nv - d->j0 || d->sub < 1 || d->sub > 64)
                 return corrupt(err, path, "bad detail window");
-            size_t nuse = (size_t)d->ni * d->nj;
-            if (nuse > rb->n - rb->at) {
-                rb->short_read = 1;
-                return ZT_ERR_PARSE;
-            }
-            d->use = malloc(nuse);
-            if (!d->use)
+            int bad = 0;
+            d->use = r_flags(rb, (size_t)d->ni * d->nj, &oom, &bad);
+            if (oom)
                 return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
-            for (size_t k2 = 0; k2 < nuse; k2++) {
-                d->use[k2] = rb->b[rb->at++];
-                if (d->use[k2] > 1)
-                    return corrupt(err, path, "bad detail window");
-            }
+            if (rb->short_read)
+                return ZT_ERR_PARSE;
+            if (bad)
+                return corrupt(err, path, "bad detail window");
             d->e = r_f32s(rb, detail_values(d), &oom);
             int has_coarse = r_i32(rb);
             if (rb->short_read)
@@ -765,19 +779,11 @@ static zt_status read_maps(zone_forest *f, rbuf *rb, int parts, int sky, const c
                 return corrupt(err, path, "bad detail window");
             if (d->e && has_split) {
                 size_t ncell = detail_values(d) / 3;
-                if (ncell > rb->n - rb->at) {
-                    rb->short_read = 1;
-                    return ZT_ERR_PARSE;
-                }
-                d->split = malloc(ncell);
-                if (!d->split)
-                    return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
-                for (size_t c = 0; c < ncell; c++) {
-                    d->split[c] = rb->b[rb->at++];
-                    if (d->split[c] > 1 ||
-                        (d->split[c] && !split_allowed(m, d, c)))
-                        return corrupt(err, path, "bad detail window");
-                }
+                d->split = r_flags(rb, ncell, &oom, &bad);
+                for (size_t c = 0; d->split && c < ncell; c++)
+                    bad |= d->split[c] && !split_allowed(m, d, c);
+                if (bad)
+                    return corrupt(err, path, "bad detail window");
                 d->far = r_f32s(rb, ncell * 6, &oom);
             }
             if (oom)
