@@ -116,6 +116,9 @@ typedef struct p2_marks {
     unsigned char *fine;    /* per pixel: a light's image in a mirror, metal
                                or glass sphere may fall here, too small for
                                the signatures: take the fine grid */
+    unsigned char *vertex;  /* per pixel: a triangle's vertex falls here; its
+                               tip can lie between every signature, so the
+                               pixel takes the edge grid */
     uint64_t *tips;         /* (pixel << 32 | light part), sorted: a vertex
                                of the light part falls in the pixel */
     size_t tip_count, tip_capacity;

@@ -5,6 +5,9 @@
  * corner can enter a pixel between its corner and sample rays; listed
  * there, it gets its exact level-0 coverage like any light seen.
  *
+ * Vertices: the pixel where each triangle's vertex falls.  A tip can
+ * enter a pixel between every signature; such a pixel takes the edge grid.
+ *
  * Fine pixels: where a light's image in a mirror, metal or glass sphere
  * falls.  Such an image can be smaller than a pixel's corner and sample
  * spacing, so no signature finds it and the pixel is shaded as smooth,
@@ -128,14 +131,34 @@ static int mark_tips(p2_marks *m, const rscene *rs, const cam *c)
     return 1;
 }
 
+/* The pixels where a triangle's vertex falls. */
+static void mark_vertices(const rscene *rs, const cam *c, unsigned char *vertex)
+{
+    for (int i = 0; i < rs->part_count; i++) {
+        const rs_part *p = &rs->parts[i];
+        if (p->shape != SHAPE_TRIANGLE)
+            continue;
+        vec3 p0 = f3_to_v3(p->p0);
+        const vec3 w[3] = {p0, v3_add(p0, f3_to_v3(p->e1)), v3_add(p0, f3_to_v3(p->e2))};
+        for (int k = 0; k < 3; k++) {
+            double px, py;
+            if (project(c, w[k], &px, &py) && px >= 0 && py >= 0 && px < c->width &&
+                py < c->height)
+                vertex[(size_t)(int)py * c->width + (int)px] = 1;
+        }
+    }
+}
+
 int p2_marks_build(p2_marks *m, const p2_ctx *ctx)
 {
     const rscene *rs = &ctx->r->rs;
     const cam *c = &ctx->c;
     memset(m, 0, sizeof *m);
     m->fine = calloc((size_t)c->width * c->height, 1);
-    if (!m->fine || !mark_tips(m, rs, c))
+    m->vertex = calloc((size_t)c->width * c->height, 1);
+    if (!m->fine || !m->vertex || !mark_tips(m, rs, c))
         return 0;
+    mark_vertices(rs, c, m->vertex);
     vec3 eye = f3_to_v3(c->viewpoint);
     for (int i = 0; i < rs->part_count; i++) {
         if (!glint_sphere(rs, i))
@@ -173,6 +196,7 @@ int p2_marks_build(p2_marks *m, const p2_ctx *ctx)
 void p2_marks_free(p2_marks *m)
 {
     free(m->fine);
+    free(m->vertex);
     free(m->tips);
     memset(m, 0, sizeof *m);
 }

@@ -352,7 +352,8 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
 {
     int g = c->g;
     uint32_t first = corners[0];
-    int edge = corners[1] != first || corners[2] != first || corners[3] != first;
+    int edge = corners[1] != first || corners[2] != first || corners[3] != first ||
+               (c->marks && c->marks->vertex[(size_t)py * c->c.width + px]);
     /* A light's image may fall here, too small for the signatures. */
     int marked = c->marks && c->marks->fine[(size_t)py * c->c.width + px];
     size_t start = row->sample_count;

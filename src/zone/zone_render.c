@@ -150,7 +150,7 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
     c.hi = o->level >= 0 ? o->level : o->depth;
     c.g = f->q.aa;
     zt_status st = p2_terms_build(&c.terms, f, r, c.lo, c.hi, err);
-    p2_marks marks = {NULL, NULL, 0, 0};
+    p2_marks marks = {NULL, NULL, NULL, 0, 0};
     if (st == ZT_OK && !p2_marks_build(&marks, &c))
         st = zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixel marks");
     c.marks = &marks;
