@@ -12,7 +12,8 @@
  * would not render what a build of 8 would.  9: the same layout, fine
  * cells measured against texels made at their own piece size.  10:
  * windows around the ends of crossings, and a window's coarse texels
- * stored only after a flag (docs/zone-tracer.md). */
+ * stored only after a flag.  11: the second values of refinement cells
+ * a crossing passes through, after a flag (docs/zone-tracer.md). */
 #define FOREST_FILE_VERSION 11
 
 /* Writes f (the forest of renderer r) to path, through a temporary file

@@ -110,6 +110,14 @@ static int cmp_u64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The three corners of triangle part p. */
+static void triangle_corners(const rs_part *p, vec3 w[3])
+{
+    w[0] = f3_to_v3(p->p0);
+    w[1] = v3_add(w[0], f3_to_v3(p->e1));
+    w[2] = v3_add(w[0], f3_to_v3(p->e2));
+}
+
 static int mark_tips(p2_marks *m, const rscene *rs, const cam *c)
 {
     for (int j = 0; j < rs->light_count; j++) {
@@ -117,9 +125,10 @@ static int mark_tips(p2_marks *m, const rscene *rs, const cam *c)
         const rs_part *lp = &rs->parts[part];
         int ok = 1;
         if (lp->shape == SHAPE_TRIANGLE) {
-            vec3 p0 = f3_to_v3(lp->p0);
-            ok = add_tip(m, c, p0, part) && add_tip(m, c, v3_add(p0, f3_to_v3(lp->e1)), part) &&
-                 add_tip(m, c, v3_add(p0, f3_to_v3(lp->e2)), part);
+            vec3 w[3];
+            triangle_corners(lp, w);
+            ok = add_tip(m, c, w[0], part) && add_tip(m, c, w[1], part) &&
+                 add_tip(m, c, w[2], part);
         } else if (lp->shape == SHAPE_SPHERE) {
             ok = add_tip(m, c, f3_to_v3(lp->p0), part);
         }
@@ -138,8 +147,8 @@ static void mark_vertices(const rscene *rs, const cam *c, unsigned char *vertex)
         const rs_part *p = &rs->parts[i];
         if (p->shape != SHAPE_TRIANGLE)
             continue;
-        vec3 p0 = f3_to_v3(p->p0);
-        const vec3 w[3] = {p0, v3_add(p0, f3_to_v3(p->e1)), v3_add(p0, f3_to_v3(p->e2))};
+        vec3 w[3];
+        triangle_corners(p, w);
         for (int k = 0; k < 3; k++) {
             double px, py;
             if (project(c, w[k], &px, &py) && px >= 0 && py >= 0 && px < c->width &&
