@@ -8,7 +8,10 @@ packages=(
   libjansson-dev                     # JSON parsing of scene files
   libembree-dev                      # ray traversal (Intel Embree 3)
   libopenexr-dev                     # OpenEXR output (its C API, OpenEXRCore)
-  libpng-dev                         # PNG output
+  libpng-dev                         # PNG output and textures
+  libjpeg62-turbo-dev                # JPEG textures
+  libassimp-dev                      # model files (OBJ, glTF, PLY, STL, ...)
+  assimp-testmodels                  # real and broken models for tests and examples
   libsdl2-dev                        # the interactive viewer's window
   libcmocka-dev                      # the test framework
   xvfb xauth                         # an X server for the viewer's tests

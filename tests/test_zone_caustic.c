@@ -1,5 +1,5 @@
-/* Caustic maps (zone/caustic.c): the light of a small triangle focused by a
- * glass ball onto the floor below, in the floor's level-2 map (light ->
+/* Caustics (zone/phase_one/caustic.c): the light of a small triangle focused
+ * by a glass ball onto the floor below, in the floor's level-2 nodes (light ->
  * glass in -> glass out -> floor), against a numerical integral at the
  * receiver: directions over the ball's cone on a fine grid, each refracted
  * into and out of the ball and tested against the light triangle. */
@@ -12,8 +12,8 @@
 #include <string.h>
 
 #include "render/render_internal.h"
-#include "zone/caustic.h"
-#include "zone/zone_internal.h"
+#include "zone/phase_one/caustic.h"
+#include "zone/zone.h"
 #include "zonetrace/render.h"
 #include "zonetrace/scene.h"
 
@@ -114,8 +114,8 @@ static void test_caustic_matches_integral(void **state)
     for (int k = -8; k <= 8; k++, n++) {
         vec3 x = v3(0.1 * k, 0, 0.02 * k);
         double ref = numeric(x, 600);
-        double a = map_lookup_wide(&lo->forest->maps[2], 2, 0, x, 0.0).x;
-        double b = map_lookup_wide(&hi->forest->maps[2], 2, 0, x, 0.0).x;
+        double a = zone_map_read((const zone_forest *)lo->forest, &lo->rs, 2, 2, 0, x).x;
+        double b = zone_map_read((const zone_forest *)hi->forest, &hi->rs, 2, 2, 0, x).x;
         printf("x %5.2f: integral %.5g, map at quality 0: %.5g, quality 2: %.5g\n", x.x, ref, a, b);
         assert_true(ref > 1e-3);
         double e = fabs(b - ref) / ref;
@@ -128,33 +128,31 @@ static void test_caustic_matches_integral(void **state)
     }
     printf("quality 2: mean relative error %.4f, max %.4f; at the cusp %.4f (quality 0 %.4f)\n",
            sum_hi / n, max_hi, cusp_hi, cusp_lo);
-    /* Fine cells (a quarter texel) where the caustic is concentrated, so
-     * even the cusp is within a few percent (measured: mean 1.6%, max 3.1%,
-     * cusp 1.9%; 6.7% at quality 0). */
-    assert_true(sum_hi / n < 0.025);
-    assert_true(max_hi < 0.05);
+    /* The floor's nodes are a uniform grid, and the deposits are sharpened
+     * by one step towards the consistent (mass-matrix) estimate: the cusp
+     * is within a few percent, the flanks within the interpolation error
+     * of the grid (measured: mean 2.9%, max 6.0% at x = +-0.1 where the
+     * profile bends fastest, cusp 2.0%; 42% at quality 0). */
+    assert_true(sum_hi / n < 0.035);
+    assert_true(max_hi < 0.075);
     assert_true(cusp_hi < cusp_lo);
     zt_renderer_release(lo);
     zt_renderer_release(hi);
     zt_scene_release(s);
 }
 
-/* The photons' sums are made in a fixed order: the same texels at any
+/* The photons' sums are made in a fixed order: the same node values at any
  * thread count. */
 static void test_caustic_deterministic(void **state)
 {
     (void)state;
     zt_scene *s = load();
     zt_renderer *a = make(s, 1, 0), *b = make(s, 2, 0);
-    const part_map *ma = &a->forest->maps[2], *mb = &b->forest->maps[2];
-    size_t n = (size_t)ma->levels * ma->layout.sides * ma->layout.nu * ma->layout.nv * 3;
-    assert_int_equal(ma->layout.nu, mb->layout.nu);
-    assert_int_equal(ma->layout.nv, mb->layout.nv);
-    assert_true(ma->details > 0 && ma->details == mb->details);
-    const map_detail *da = &ma->detail[0], *db = &mb->detail[0];
-    assert_true(da->ni == db->ni && da->nj == db->nj);
-    assert_memory_equal(da->e, db->e, (size_t)da->ni * da->nj * da->sub * da->sub * 3 * sizeof(float));
-    assert_memory_equal(ma->texels, mb->texels, n * sizeof(float));
+    const zone_forest *fa = (const zone_forest *)a->forest, *fb = (const zone_forest *)b->forest;
+    assert_int_equal(fa->sn.node_count, fb->sn.node_count);
+    assert_int_equal(fa->map_levels, fb->map_levels);
+    size_t n = (size_t)fa->map_levels * fa->sn.node_count * 3;
+    assert_memory_equal(fa->e, fb->e, n * sizeof(float));
     zt_renderer_release(a);
     zt_renderer_release(b);
     zt_scene_release(s);

@@ -312,6 +312,12 @@ int cli_render(int argc, char **argv)
         fprintf(stderr, "scene %s: %d lights (%d parts), %d things (%d parts), %dx%d\n",
                 scene_path, info.lights, info.light_parts, info.things, info.thing_parts,
                 cam.width, cam.height);
+        if (info.meshes)
+            fprintf(stderr, "meshes: %d, %lld triangles (%lld degenerate ones skipped)\n",
+                    info.meshes, info.mesh_triangles, info.skipped_triangles);
+        if (info.rough_materials)
+            fprintf(stderr, "note: %d model materials have a roughness, which is ignored: "
+                    "metal, mirror and glass lobes are smooth\n", info.rough_materials);
         fprintf(stderr, "method %s, depth %d, level %s%d\n",
                 opt.method == ZT_METHOD_PATH ? "path" : "zone", opt.depth,
                 opt.level < 0 ? "all up to " : "", opt.level < 0 ? opt.depth : opt.level);

@@ -47,9 +47,15 @@ zt_scene *zt_scene_clone(const zt_scene *scene);
 typedef struct zt_scene_info {
     int lights;       /* light objects (groups count once) */
     int things;       /* passive objects (groups count once) */
-    int light_parts;  /* emitting primitives */
-    int thing_parts;  /* passive primitives */
-    int spheres, planes, triangles, points; /* primitives of each kind */
+    int light_parts;  /* emitting primitives (mesh triangles included) */
+    int thing_parts;  /* passive primitives (mesh triangles included) */
+    int spheres, planes, triangles, points; /* primitives of each kind,
+                                               meshes' triangles apart */
+    int meshes;       /* objects made from model files */
+    long long mesh_triangles; /* their triangles */
+    long long skipped_triangles; /* degenerate ones the import left out */
+    int rough_materials; /* materials whose roughness the smooth lobes
+                            cannot represent (it is ignored) */
     int has_sky;      /* non-zero when a sky colour is given */
 } zt_scene_info;
 
@@ -58,6 +64,15 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out);
 /* The scene's camera (a copy) and a way to replace it. */
 zt_camera zt_scene_get_camera(const zt_scene *scene);
 void zt_scene_set_camera(zt_scene *scene, const zt_camera *camera);
+
+/* A camera at position looking at lookat, with up (any vector not parallel
+ * to the view) pointing up in the image, a vertical field of view of
+ * fov_degrees (0 < fov < 180) and square pixels on a width x height grid.
+ * The screen (which is also the near plane) lies at a thousandth of the
+ * distance to lookat.  ZT_ERR_ARGUMENT for a degenerate camera. */
+zt_status zt_camera_look_at(zt_camera *out, const double position[3], const double lookat[3],
+                            const double up[3], double fov_degrees, int width, int height,
+                            zt_error *err);
 
 /* Keeps the camera's screen but changes its pixel grid (--size). */
 zt_status zt_camera_set_resolution(zt_camera *camera, int width, int height,

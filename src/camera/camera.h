@@ -9,6 +9,9 @@
 typedef struct cam {
     vec3f viewpoint;
     vec3f top_left;
+    vec3f to_screen; /* top-left minus viewpoint, rounded once from double:
+                        the screen may be tiny next to the viewpoint's
+                        coordinates (an aimed camera far from the origin) */
     vec3f right;   /* top-right minus top-left: the whole screen width */
     vec3f down;    /* bottom-left minus top-left: the whole screen height */
     int width, height;
@@ -21,11 +24,11 @@ void cam_init(cam *c, const zt_camera *camera);
 static inline void cam_ray(const cam *c, float px, float py, vec3f *origin,
                            vec3f *dir)
 {
-    vec3f p = f3_add(c->top_left,
-                     f3_add(f3_scale(c->right, px / (float)c->width),
-                            f3_scale(c->down, py / (float)c->height)));
-    *origin = p;
-    *dir = f3_normalize(f3_sub(p, c->viewpoint));
+    vec3f rel = f3_add(c->to_screen,
+                       f3_add(f3_scale(c->right, px / (float)c->width),
+                              f3_scale(c->down, py / (float)c->height)));
+    *origin = f3_add(c->viewpoint, rel);
+    *dir = f3_normalize(rel);
 }
 
 #endif

@@ -1,10 +1,11 @@
-/* The simplest backend: test every primitive.  Slow, obviously right, and
+/* The simplest backend: test every primitive (mesh triangles too).  Slow, obviously right, and
  * the oracle the other backends are tested against. */
 #include "geom/accel_internal.h"
 
 #include <stdlib.h>
 
 #include "geom/shapes.h"
+#include "render/prim.h"
 #include "util/error.h"
 
 typedef struct brute {
@@ -15,8 +16,9 @@ typedef struct brute {
 static void brute_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
 {
     const rscene *rs = ((const brute *)a)->rs;
-    for (int i = 0; i < rs->part_count; i++) {
-        const rs_part *p = &rs->parts[i];
+    for (int i = 0; i < rs->prim_count; i++) {
+        rs_part tmp;
+        const rs_part *p = rs_prim(rs, i, &tmp);
         if (p->background != layer || p->shape == SHAPE_PLANE)
             continue;
         float t = shape_hit(p, o, d, 0.0f, h->t);
@@ -30,8 +32,9 @@ static void brute_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
 static int brute_any(const accel *a, int layer, vec3f o, vec3f d, float tmax)
 {
     const rscene *rs = ((const brute *)a)->rs;
-    for (int i = 0; i < rs->part_count; i++) {
-        const rs_part *p = &rs->parts[i];
+    for (int i = 0; i < rs->prim_count; i++) {
+        rs_part tmp;
+        const rs_part *p = rs_prim(rs, i, &tmp);
         if (p->background == layer && p->shape != SHAPE_PLANE &&
             shape_hit(p, o, d, 0.0f, tmax) > 0.0f)
             return 1;

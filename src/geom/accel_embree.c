@@ -1,7 +1,9 @@
 /* The Embree 3 backend.  Each layer (foreground, background) is one Embree
- * scene with up to two geometries: the triangles and the spheres.  Embree
- * has no per-primitive back-face culling, so culled primitives are rejected
- * in a filter function, attached only to geometries that have any. */
+ * scene with up to two geometries for the parts, the triangles and the
+ * spheres, and one per mesh, which reads the mesh's own arrays (shared
+ * buffers: nothing is copied).  Embree has no per-primitive back-face
+ * culling, so culled primitives are rejected in a filter function, attached
+ * only to geometries that have any. */
 #include "geom/accel_internal.h"
 
 #include <embree3/rtcore.h>
@@ -9,14 +11,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/mesh.h"
 #include "util/error.h"
 
 enum { GEOM_TRIANGLES, GEOM_SPHERES, GEOM_KINDS };
 
 typedef struct geom_map {
-    int *part_of_prim;   /* primitive index -> part index */
+    int *part_of_prim;   /* primitive index -> part index; NULL for a mesh */
+    int prim_base;       /* a mesh: its first primitive number */
     const rscene *rs;
-    int kind;
+    int kind;            /* GEOM_TRIANGLES for meshes */
 } geom_map;
 
 typedef struct embree_accel {
@@ -24,8 +28,15 @@ typedef struct embree_accel {
     RTCDevice device;
     RTCScene scene[2];
     int empty[2];
-    geom_map map[2][GEOM_KINDS]; /* by layer and geometry id (= kind) */
+    /* By layer and geometry id: the parts' kinds, then mesh k at
+     * GEOM_KINDS + k (in the layer the mesh is in). */
+    geom_map *map[2];
 } embree_accel;
+
+static inline int prim_of(const geom_map *m, unsigned prim)
+{
+    return m->part_of_prim ? m->part_of_prim[prim] : m->prim_base + (int)prim;
+}
 
 /* Rejects hits on the back of culled primitives. */
 static void cull_filter(const struct RTCFilterFunctionNArguments *args)
@@ -38,11 +49,19 @@ static void cull_filter(const struct RTCFilterFunctionNArguments *args)
         if (args->valid[i] != -1)
             continue;
         unsigned prim = ((const unsigned *)hitv)[5 * n + i];
+        vec3f d = f3(ray[4 * n + i], ray[5 * n + i], ray[6 * n + i]);
+        vec3f facing;
+        if (!m->part_of_prim) {
+            /* A culled mesh: Embree's own geometric normal, Ng = e1 x e2 for
+             * its vertex order (the front is counter-clockwise). */
+            facing = f3(hitv[0 * n + i], hitv[1 * n + i], hitv[2 * n + i]);
+            if (f3_dot(facing, d) >= 0.0f)
+                args->valid[i] = 0;
+            continue;
+        }
         const rs_part *p = &m->rs->parts[m->part_of_prim[prim]];
         if (!p->culled)
             continue;
-        vec3f d = f3(ray[4 * n + i], ray[5 * n + i], ray[6 * n + i]);
-        vec3f facing;
         if (m->kind == GEOM_TRIANGLES) {
             facing = p->n;
         } else {
@@ -76,7 +95,7 @@ static void embree_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
     rtcIntersect1(e->scene[layer], &ctx, &rh);
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
         h->t = rh.ray.tfar;
-        h->part = e->map[layer][rh.hit.geomID].part_of_prim[rh.hit.primID];
+        h->part = prim_of(&e->map[layer][rh.hit.geomID], rh.hit.primID);
     }
 }
 
@@ -111,8 +130,10 @@ static void embree_destroy(accel *a)
     for (int l = 0; l < 2; l++) {
         if (e->scene[l])
             rtcReleaseScene(e->scene[l]);
-        for (int k = 0; k < GEOM_KINDS; k++)
-            free(e->map[l][k].part_of_prim);
+        if (e->map[l])
+            for (int k = 0; k < GEOM_KINDS; k++)
+                free(e->map[l][k].part_of_prim);
+        free(e->map[l]);
     }
     if (e->device)
         rtcReleaseDevice(e->device);
@@ -192,6 +213,33 @@ static int add_geometry(embree_accel *e, const rscene *rs, int layer, int kind)
     return 1;
 }
 
+/* Adds mesh k as geometry GEOM_KINDS + k of its layer, on its own arrays. */
+static int add_mesh(embree_accel *e, const rscene *rs, int k)
+{
+    const rs_mesh *mm = &rs->meshes[k];
+    int layer = mm->background;
+    RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                               mm->m->position, 0, 3 * sizeof(float),
+                               (size_t)mm->m->vertex_count);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mm->m->index, 0,
+                               3 * sizeof(unsigned), (size_t)mm->m->triangle_count);
+    geom_map *gm = &e->map[layer][GEOM_KINDS + k];
+    gm->rs = rs;
+    gm->kind = GEOM_TRIANGLES;
+    gm->prim_base = mm->prim_base;
+    if (mm->culled) {
+        rtcSetGeometryUserData(g, gm);
+        rtcSetGeometryIntersectFilterFunction(g, cull_filter);
+        rtcSetGeometryOccludedFilterFunction(g, cull_filter);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(e->scene[layer], g, (unsigned)(GEOM_KINDS + k));
+    rtcReleaseGeometry(g);
+    e->empty[layer] = 0;
+    return rtcGetDeviceError(e->device) == RTC_ERROR_NONE;
+}
+
 zt_status accel_build_embree(rscene *rs, zt_error *err)
 {
     embree_accel *e = calloc(1, sizeof *e);
@@ -208,15 +256,26 @@ zt_status accel_build_embree(rscene *rs, zt_error *err)
     }
     for (int l = 0; l < 2; l++) {
         e->empty[l] = 1;
+        e->map[l] = calloc((size_t)(GEOM_KINDS + rs->mesh_count), sizeof(geom_map));
         e->scene[l] = rtcNewScene(e->device);
+        if (!e->map[l]) {
+            embree_destroy(&e->base);
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory building Embree scene");
+        }
         rtcSetSceneBuildQuality(e->scene[l], RTC_BUILD_QUALITY_HIGH);
         for (int k = 0; k < GEOM_KINDS; k++)
             if (!add_geometry(e, rs, l, k)) {
                 embree_destroy(&e->base);
                 return zt_fail(err, ZT_ERR_MEMORY, "out of memory building Embree scene");
             }
-        rtcCommitScene(e->scene[l]);
     }
+    for (int k = 0; k < rs->mesh_count; k++)
+        if (!add_mesh(e, rs, k)) {
+            embree_destroy(&e->base);
+            return zt_fail(err, ZT_ERR_MEMORY, "Embree could not take mesh %d", k);
+        }
+    for (int l = 0; l < 2; l++)
+        rtcCommitScene(e->scene[l]);
     if (rtcGetDeviceError(e->device) != RTC_ERROR_NONE) {
         embree_destroy(&e->base);
         return zt_fail(err, ZT_ERR_UNSUPPORTED, "Embree failed to build the scene");

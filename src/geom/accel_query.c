@@ -141,5 +141,7 @@ zt_status accel_build(rscene *rs, accel_kind kind, zt_error *err)
         if (p->shape == SHAPE_TRIANGLE || p->shape == SHAPE_SPHERE)
             rs->accel->has_prims[p->background] = 1;
     }
+    for (int k = 0; k < rs->mesh_count; k++)
+        rs->accel->has_prims[rs->meshes[k].background] = 1;
     return ZT_OK;
 }

@@ -3,6 +3,7 @@
  * node takes the children of its largest inner children until it has
  * four) with the leaves' primitives packed into packets of four. */
 #include "geom/bvh.h"
+#include "render/prim.h"
 
 #include <float.h>
 #include <math.h>
@@ -345,7 +346,8 @@ static int32_t pack_leaf(collapser *c, const bin_node *leaf)
         int lane = BVH_WIDTH;
         for (int k = leaf->index; k < leaf->index + leaf->count; k++) {
             int part = c->refs[k].part;
-            const rs_part *p = &c->rs->parts[part];
+            rs_part tmp;
+            const rs_part *p = rs_prim(c->rs, part, &tmp);
             if (p->shape != shapes[s])
                 continue;
             if (lane == BVH_WIDTH) {
@@ -422,8 +424,10 @@ int bvh_build(bvh_tree *tr, const rscene *rs, int layer)
     tr->packets = NULL;
     tr->node_count = tr->packet_count = 0;
     int count = 0;
-    for (int i = 0; i < rs->part_count; i++)
-        count += in_layer(&rs->parts[i], layer);
+    for (int i = 0; i < rs->prim_count; i++) {
+        rs_part tmp;
+        count += in_layer(rs_prim(rs, i, &tmp), layer);
+    }
     if (count == 0)
         return 1;
     prim_ref *refs = malloc((size_t)count * sizeof *refs);
@@ -439,11 +443,14 @@ int bvh_build(bvh_tree *tr, const rscene *rs, int layer)
         return 0;
     }
     int k = 0;
-    for (int i = 0; i < rs->part_count; i++)
-        if (in_layer(&rs->parts[i], layer)) {
-            refs[k].b = part_box(&rs->parts[i]);
+    for (int i = 0; i < rs->prim_count; i++) {
+        rs_part tmp;
+        const rs_part *p = rs_prim(rs, i, &tmp);
+        if (in_layer(p, layer)) {
+            refs[k].b = part_box(p);
             refs[k++].part = i;
         }
+    }
     builder b = {refs, bin, 0};
     build_node(&b, 0, count, 0);
     collapser c = {bin, refs, rs, tr};

@@ -1,6 +1,7 @@
 #include "light/light_sample.h"
 
 #include "geom/shapes.h"
+#include "render/prim.h"
 #include "material/bsdf.h"
 #include "util/sincos_turn.h"
 
@@ -111,7 +112,8 @@ int light_sample_point(const rscene *rs, vec3f x, float u_select,
     if (rs->light_count == 0)
         return 0;
     const rs_light *l = &rs->lights[pick_light(rs, u_select)];
-    const rs_part *p = &rs->parts[l->part];
+    rs_part tmp;
+    const rs_part *p = rs_prim(rs, l->part, &tmp);
     const rs_object *o = &rs->objects[p->object];
     out->part = l->part;
     out->delta = 0;
@@ -125,7 +127,7 @@ int light_sample_point(const rscene *rs, vec3f x, float u_select,
         out->dist = sqrtf(d2);
         out->wi = f3_scale(v, 1.0f / out->dist);
         out->li = f3_scale(o->emission, 1.0f / d2);
-        out->pdf = l->select_pdf;
+        out->pdf = p->select_pdf;
         out->delta = 1;
         return 1;
     }
@@ -136,16 +138,15 @@ int light_sample_point(const rscene *rs, vec3f x, float u_select,
     if (!ok || !(out->pdf > 0.0f) || !isfinite(out->pdf))
         return 0;
     out->li = o->emission;
-    out->pdf *= l->select_pdf;
+    out->pdf *= p->select_pdf;
     return 1;
 }
 
-float light_pdf(const rscene *rs, int part, vec3f x, vec3f wi, float t)
+float light_pdf(const rs_part *p, vec3f x, vec3f wi, float t)
 {
-    const rs_part *p = &rs->parts[part];
-    if (p->light < 0)
+    float sel = p->select_pdf;
+    if (!(sel > 0.0f))
         return 0.0f;
-    float sel = rs->lights[p->light].select_pdf;
     switch (p->shape) {
     case SHAPE_TRIANGLE: {
         float c = fabsf(f3_dot(p->n, wi));

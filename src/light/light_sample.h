@@ -25,8 +25,8 @@ int light_sample_point(const rscene *rs, vec3f x, float u_select,
                        const float u2[2], light_sample *out);
 
 /* The density with which light_sample_point would have chosen direction wi
- * from x, reaching light part `part` at distance t. */
-float light_pdf(const rscene *rs, int part, vec3f x, vec3f wi, float t);
+ * from x, reaching light primitive p (rs_prim) at distance t. */
+float light_pdf(const rs_part *p, vec3f x, vec3f wi, float t);
 
 /* Radiance leaving light part p at point y towards direction -d (d is the
  * ray direction arriving at y). */

@@ -11,6 +11,7 @@
 #include "geom/shapes.h"
 #include "light/light_sample.h"
 #include "material/bsdf.h"
+#include "render/prim.h"
 #include "util/sampler.h"
 
 #define MEDIUM_STACK 8
@@ -82,14 +83,15 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 radiance = f3_add(radiance, f3_mul(beta, rs->sky));
             break;
         }
-        const rs_part *p = &rs->parts[h.part];
+        rs_part tri;
+        const rs_part *p = rs_prim(rs, h.part, &tri);
         vec3f x = f3_madd(o, d, h.t);
         if (p->is_light) {
             if (counted) {
                 vec3f le = light_emitted(rs, p, x, d);
                 float w = 1.0f;
-                if (!prev_delta && p->light >= 0)
-                    w = power_heuristic(prev_pdf, light_pdf(rs, h.part, prev_x, d, h.t));
+                if (!prev_delta && p->select_pdf > 0.0f)
+                    w = power_heuristic(prev_pdf, light_pdf(p, prev_x, d, h.t));
                 radiance = f3_add(radiance, f3_scale(f3_mul(beta, le), w));
             }
             break; /* lights absorb what reaches them */
@@ -102,6 +104,22 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         vec3f ng = shape_normal(p, x);
         vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
         vec3f wo = f3_neg(d);
+        /* Meshes: the shading normal ns (the geometric n still decides
+         * sides) and a textured albedo, in a copy of the material. */
+        vec3f ns = n;
+        int bent = 0;
+        rs_object textured;
+        if (rs_needs_shade(rs, h.part, m)) {
+            rs_shade sh;
+            rs_shade_at(rs, h.part, p, m, x, n, &sh);
+            ns = sh.ns;
+            bent = ns.x != n.x || ns.y != n.y || ns.z != n.z;
+            if (m->texture) {
+                textured = *m;
+                textured.color = sh.albedo;
+                m = &textured;
+            }
+        }
         uint32_t pair = 1 + (uint32_t)(k - 1) * PAIRS_PER_VERTEX;
         int nee = k >= pp->min_level && m->weight[LOBE_DIFFUSE] > 0.0f;
         /* Numbers from the stream are drawn only where a choice needs
@@ -123,12 +141,14 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
 
         /* Next-event estimation through the diffuse lobe. */
         light_sample ls;
-        if (nee && light_sample_point(rs, x, u_select, u_light, &ls)) {
+        if (nee && light_sample_point(rs, x, u_select, u_light, &ls) &&
+            (!bent || f3_dot(n, ls.wi) > 0.0f)) {
             float bsdf_pdf;
-            vec3f fcos = bsdf_eval_diffuse(m, n, ls.wi, &bsdf_pdf);
+            vec3f fcos = bsdf_eval_diffuse(m, ns, ls.wi, &bsdf_pdf);
             if (bsdf_pdf > 0.0f && !f3_is_black(ls.li)) {
                 n_rays++;
-                const rs_part *lp = &rs->parts[ls.part];
+                rs_part ltri;
+                const rs_part *lp = rs_prim(rs, ls.part, &ltri);
                 /* Aim the shadow ray from the offset origin at the sampled
                  * point itself: near a sphere's rim, keeping the direction
                  * and distance measured from x would graze the light and
@@ -148,14 +168,17 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         /* Continue along a sampled direction.  Flat parts carry their
          * frame; with n flipped, (t, b, n) is still orthonormal
          * (left-handed), which the cosine lobe does not mind. */
-        shading_frame frame = {p->tangent, p->bitangent, n};
-        if (p->shape == SHAPE_SPHERE)
-            f3_basis(n, &frame.t, &frame.b);
+        shading_frame frame = {p->tangent, p->bitangent, ns};
+        if (p->shape == SHAPE_SPHERE || bent)
+            f3_basis(ns, &frame.t, &frame.b);
         bsdf_sample bs;
         if (!m->lobe_choice && m->weight[LOBE_DIFFUSE] > 0.0f) {
             /* Diffuse only, the common case: no lobe or split to draw, no
              * medium to track, and the same sample as the general call. */
             if (!bsdf_sample_diffuse(m, &frame, u_dir, &bs))
+                break;
+            /* Below the geometric surface: the light would leak. */
+            if (bent && f3_dot(bs.wi, n) <= 0.0f)
                 break;
             beta = f3_mul(beta, bs.weight);
             if (f3_is_black(beta))
@@ -169,6 +192,8 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             float u_split = m->weight[LOBE_REFRACTIVE] > 0.0f ? sampler_next(&rng) : 0.0f;
             if (!bsdf_sample_material(m, &frame, wo, u_lobe, u_split, u_dir,
                                       eta_i, eta_t, &bs))
+                break;
+            if (bent && (f3_dot(bs.wi, n) > 0.0f) == (bs.transmit != 0))
                 break;
             beta = f3_mul(beta, bs.weight);
             if (f3_is_black(beta))

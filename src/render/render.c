@@ -88,7 +88,8 @@ static zt_status renderer_create(const zt_scene *scene, const zt_render_options 
     }
     r->options = *o;
     st = rscene_build(&r->rs, r->scene, o->lights_off, o->lights_off_count,
-                      render_accel_kind(r->scene->part_count), err);
+                      render_accel_kind(r->scene->part_count +
+                                        scene_mesh_triangles(r->scene)), err);
     if (st == ZT_OK && o->method == ZT_METHOD_ZONE)
         st = zone_prepare(r, stats, err);
     if (st != ZT_OK) {

@@ -52,6 +52,6 @@ void zone_release(zt_renderer *r);
  * for small scenes, Embree for large ones, unless ZT_ACCEL in the
  * environment says "embree", "bvh" or "brute" (for tests and benchmarks). */
 #define ACCEL_SMALL_SCENE 1000
-int render_accel_kind(int primitives);
+int render_accel_kind(long long primitives);
 
 #endif

@@ -5,6 +5,8 @@
 #include <string.h>
 
 #include "geom/accel.h"
+#include "render/prim.h"
+#include "scene/mesh.h"
 #include "util/error.h"
 #include "util/vec3_convert.h"
 
@@ -28,6 +30,59 @@ static double part_power(const rs_part *p, const rs_object *o)
     case SHAPE_POINT: return lum * 4 * 3.14159265358979;
     default: return 0;
     }
+}
+
+static void fill_object(rs_object *ro, const material *mat, vec3 emission, int is_light,
+                        const object *o)
+{
+    int lobes = 0;
+    for (int k = 0; k < LOBE_COUNT; k++) {
+        ro->weight[k] = (float)mat->weight[k];
+        lobes += ro->weight[k] > 0.0f;
+    }
+    ro->lobe_choice = lobes > 1;
+    ro->color = v3_to_f3(mat->color);
+    ro->ior = (float)mat->ior;
+    ro->is_light = (uint8_t)is_light;
+    ro->culled = (uint8_t)o->backculled;
+    ro->background = (uint8_t)o->background;
+    ro->emission = v3_to_f3(emission);
+}
+
+/* The meshes' table and their slots' objects (after the scene's own). */
+static int build_meshes(rscene *rs, const zt_scene *scene, const int *lights_off,
+                        int lights_off_count)
+{
+    int objects = scene->object_count, prims = scene->part_count;
+    for (int i = 0; i < scene->object_count; i++) {
+        const object *o = &scene->objects[i];
+        if (o->mesh < 0)
+            continue;
+        const mesh *m = scene->meshes[o->mesh];
+        rs_mesh *mm = &rs->meshes[rs->mesh_count++];
+        mm->m = m;
+        mm->prim_base = prims;
+        mm->object_base = objects;
+        mm->is_light = (uint8_t)o->is_light;
+        mm->culled = (uint8_t)o->backculled;
+        mm->background = (uint8_t)o->background;
+        mm->smooth = m->normal != NULL;
+        prims += m->triangle_count;
+        if (o->is_light) {
+            int off = light_is_off(o->index, lights_off, lights_off_count);
+            fill_object(&rs->objects[objects++], &o->mat, off ? v3(0, 0, 0) : o->emission, 1, o);
+            continue;
+        }
+        for (int k = 0; k < m->slot_count; k++) {
+            const mesh_slot *sl = &m->slots[k];
+            rs_object *ro = &rs->objects[objects++];
+            fill_object(ro, &sl->mat, sl->emission, !v3_is_black(sl->emission), o);
+            if (sl->texture >= 0 && !ro->is_light && m->uv)
+                ro->texture = &m->textures[sl->texture];
+        }
+    }
+    rs->prim_count = prims;
+    return objects;
 }
 
 static void fill_part(rs_part *rp, const part *p, const object *o)
@@ -94,16 +149,30 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
                        int accel_choice, zt_error *err)
 {
     memset(rs, 0, sizeof *rs);
+    /* Light triangles of meshes and the meshes' slots, to size the tables. */
+    long long mesh_lights = 0, slots = 0;
+    for (int i = 0; i < scene->object_count; i++) {
+        const object *o = &scene->objects[i];
+        if (o->mesh < 0)
+            continue;
+        const mesh *m = scene->meshes[o->mesh];
+        slots += o->is_light ? 1 : m->slot_count;
+        for (int t = 0; t < m->triangle_count; t++)
+            mesh_lights += o->is_light || !v3_is_black(m->slots[mesh_slot_of(m, t)].emission);
+    }
+    if ((long long)scene->part_count + scene_mesh_triangles(scene) > INT32_MAX - 1)
+        return zt_fail(err, ZT_ERR_UNSUPPORTED, "the scene has more than 2^31 - 2 primitives");
     rs->part_count = scene->part_count;
-    rs->object_count = scene->object_count;
     rs->parts = calloc((size_t)(scene->part_count + 1), sizeof(rs_part));
-    rs->objects = calloc((size_t)(scene->object_count + 1), sizeof(rs_object));
-    rs->lights = calloc((size_t)(scene->part_count + 1), sizeof(rs_light));
+    rs->objects = calloc((size_t)(scene->object_count + slots + 1), sizeof(rs_object));
+    rs->lights = calloc((size_t)(scene->part_count + mesh_lights + 1), sizeof(rs_light));
     rs->point_lights = calloc((size_t)(scene->part_count + 1), sizeof(int));
+    rs->meshes = calloc((size_t)(scene->mesh_count + 1), sizeof(rs_mesh));
     int planes_ok = 1;
     for (int l = 0; l < 2; l++)
         planes_ok &= planes_alloc(&rs->planes[l], scene, l);
-    if (!rs->parts || !rs->objects || !rs->lights || !rs->point_lights || !planes_ok) {
+    if (!rs->parts || !rs->objects || !rs->lights || !rs->point_lights || !rs->meshes ||
+        !planes_ok) {
         rscene_free(rs);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     }
@@ -111,21 +180,10 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
 
     for (int i = 0; i < scene->object_count; i++) {
         const object *o = &scene->objects[i];
-        rs_object *ro = &rs->objects[i];
-        int lobes = 0;
-        for (int k = 0; k < LOBE_COUNT; k++) {
-            ro->weight[k] = (float)o->mat.weight[k];
-            lobes += ro->weight[k] > 0.0f;
-        }
-        ro->lobe_choice = lobes > 1;
-        ro->color = v3_to_f3(o->mat.color);
-        ro->ior = (float)o->mat.ior;
-        ro->is_light = (uint8_t)o->is_light;
-        ro->culled = (uint8_t)o->backculled;
-        ro->background = (uint8_t)o->background;
-        if (o->is_light && !light_is_off(o->index, lights_off, lights_off_count))
-            ro->emission = v3_to_f3(o->emission);
+        int on = o->is_light && !light_is_off(o->index, lights_off, lights_off_count);
+        fill_object(&rs->objects[i], &o->mat, on ? o->emission : v3(0, 0, 0), o->is_light, o);
     }
+    rs->object_count = build_meshes(rs, scene, lights_off, lights_off_count);
 
     double total = 0;
     for (int i = 0; i < scene->part_count; i++) {
@@ -153,13 +211,36 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
             total += power;
         }
     }
+    /* Emitting mesh triangles, each a light of its own (power-proportional
+     * choice lets thousands of them converge). */
+    for (int k = 0; k < rs->mesh_count; k++) {
+        const rs_mesh *mm = &rs->meshes[k];
+        for (int t = 0; t < mm->m->triangle_count; t++) {
+            int prim = mm->prim_base + t;
+            const rs_object *o = &rs->objects[rs_mesh_object(mm, prim)];
+            if (!o->is_light)
+                continue;
+            rs_part tri;
+            rs_mesh_part(rs, mm, prim, &tri);
+            double power = part_power(&tri, o);
+            if (power > 0) {
+                rs->lights[rs->light_count].part = prim;
+                rs->lights[rs->light_count].select_pdf = (float)power;
+                rs->light_count++;
+                total += power;
+            }
+        }
+    }
     double cdf = 0;
     for (int i = 0; i < rs->light_count; i++) {
         double pdf = rs->lights[i].select_pdf / total;
         cdf += pdf;
         rs->lights[i].select_pdf = (float)pdf;
         rs->lights[i].select_cdf = i == rs->light_count - 1 ? 1.0f : (float)cdf;
+        if (rs->lights[i].part < rs->part_count)
+            rs->parts[rs->lights[i].part].select_pdf = (float)pdf;
     }
+    rs->light_power = (float)total;
 
     zt_status st = accel_build(rs, (accel_kind)accel_choice, err);
     if (st != ZT_OK) {
@@ -176,6 +257,7 @@ void rscene_free(rscene *rs)
     free(rs->objects);
     free(rs->lights);
     free(rs->point_lights);
+    free(rs->meshes);
     for (int l = 0; l < 2; l++) {
         free(rs->planes[l].nx);
         free(rs->planes[l].part);

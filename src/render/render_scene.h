@@ -11,7 +11,9 @@
 struct accel;
 
 /* One primitive.  The index of a part here equals its index in the scene
- * model, so hits can be traced back to the file. */
+ * model, so hits can be traced back to the file.  Mesh triangles are
+ * primitives too, but are not stored as rs_part: they are numbered after
+ * the parts (prim.h) and an rs_part is made for one when it is needed. */
 typedef struct rs_part {
     uint8_t shape;      /* part_shape */
     uint8_t is_light;
@@ -27,6 +29,8 @@ typedef struct rs_part {
     float radius;       /* sphere */
     float offset;       /* plane: n.x = offset */
     float area;         /* triangle/sphere surface area */
+    float select_pdf;   /* next-event estimation's probability of choosing
+                           it (0: not sampled) */
 } rs_part;
 
 typedef struct rs_object {
@@ -39,7 +43,23 @@ typedef struct rs_object {
     uint8_t background;
     uint8_t lobe_choice; /* more than one lobe has weight: choosing takes a
                             random number */
+    const struct mesh_texture *texture; /* base colour, times color; NULL */
 } rs_object;
+
+/* A mesh of the scene model as the renderers see it: its arrays are the
+ * scene's (shared, not copied); its triangles are primitives
+ * prim_base .. prim_base + triangle count - 1, and triangle t's object is
+ * object_base + its slot (a mesh light has one object for all). */
+struct mesh;
+typedef struct rs_mesh {
+    const struct mesh *m;
+    int prim_base;
+    int object_base;
+    uint8_t is_light;   /* a mesh light: every triangle emits */
+    uint8_t culled;
+    uint8_t background;
+    uint8_t smooth;     /* shading normals from the mesh's vertex normals */
+} rs_mesh;
 
 /* An emitting part that next-event estimation can sample. */
 typedef struct rs_light {
@@ -62,7 +82,10 @@ typedef struct rs_planes {
 typedef struct rscene {
     rs_part *parts;
     int part_count;
-    rs_object *objects;
+    rs_mesh *meshes;    /* by prim_base, ascending */
+    int mesh_count;
+    int prim_count;     /* parts and mesh triangles */
+    rs_object *objects; /* the scene model's objects, then the meshes' slots */
     int object_count;
     rs_light *lights;   /* parts sampled by next-event estimation */
     int light_count;
@@ -73,6 +96,8 @@ typedef struct rscene {
      * against every ray. */
     rs_planes planes[2];
     vec3f sky;
+    float light_power;  /* total of the sampled lights' power (select_pdf's
+                           denominator) */
     struct accel *accel;
 } rscene;
 

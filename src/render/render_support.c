@@ -20,7 +20,7 @@ int render_thread_count(int requested)
     return requested > 0 ? requested : omp_get_num_procs();
 }
 
-int render_accel_kind(int primitives)
+int render_accel_kind(long long primitives)
 {
     const char *e = getenv("ZT_ACCEL");
     if (e && strcmp(e, "brute") == 0)

@@ -53,11 +53,55 @@ static zt_status check_screen(load_ctx *ctx, jref screen, jref viewpoint,
     return ZT_OK;
 }
 
+/* {"position", "lookat", "up", "fov", "gridresolution"}: an aimed camera. */
+static zt_status load_aimed(load_ctx *ctx, jref ref, zt_camera *out)
+{
+    static const char *const keys[] = {"position", "lookat", "up", "fov", "gridresolution",
+                                       NULL};
+    if (load_known_keys(ctx, ref, "camera", keys) ||
+        load_require(ctx, ref, "position", "camera") ||
+        load_require(ctx, ref, "lookat", "camera"))
+        return ZT_ERR_PARSE;
+    vec3 pos, at, up = v3(0, 1, 0);
+    double fov = 40;
+    zt_camera cam = {{0}, {{0}}, 512, 512};
+    jref pos_ref = jref_member(ref.value, "position");
+    jref up_ref = jref_member(ref.value, "up");
+    jref fov_ref = jref_member(ref.value, "fov");
+    jref grid = jref_member(ref.value, "gridresolution");
+    if (load_triple(ctx, pos_ref, &pos) ||
+        load_triple(ctx, jref_member(ref.value, "lookat"), &at) ||
+        (up_ref.value && load_triple(ctx, up_ref, &up)) ||
+        (fov_ref.value && load_number(ctx, fov_ref, &fov)) ||
+        (grid.value && load_resolution(ctx, grid, &cam)))
+        return ZT_ERR_PARSE;
+    if (!(fov > 0 && fov < 180))
+        return load_fail(ctx, fov_ref, "fov out of range: %g (the vertical field of view, "
+                         "in degrees, between 0 and 180)", fov);
+    double p[3], a[3], u[3];
+    v3_store(pos, p);
+    v3_store(at, a);
+    v3_store(up, u);
+    zt_error cerr;
+    zt_error_clear(&cerr);
+    if (zt_camera_look_at(&cam, p, a, u, fov, cam.width, cam.height, &cerr) != ZT_OK)
+        return load_fail(ctx, pos_ref, "degenerate camera: %s", cerr.message);
+    *out = cam;
+    return ZT_OK;
+}
+
 zt_status load_camera(load_ctx *ctx, jref ref, zt_camera *out)
 {
     static const char *const keys[] = {"viewpoint", "screen", "gridresolution", NULL};
-    if (load_object(ctx, ref, "camera") ||
-        load_known_keys(ctx, ref, "camera", keys) ||
+    if (load_object(ctx, ref, "camera"))
+        return ZT_ERR_PARSE;
+    if (json_object_get(ref.value, "position") || json_object_get(ref.value, "lookat")) {
+        if (json_object_get(ref.value, "viewpoint") || json_object_get(ref.value, "screen"))
+            return load_fail(ctx, ref, "a camera is given either by viewpoint and screen or "
+                             "by position and lookat, not both");
+        return load_aimed(ctx, ref, out);
+    }
+    if (load_known_keys(ctx, ref, "camera", keys) ||
         load_require(ctx, ref, "viewpoint", "camera") ||
         load_require(ctx, ref, "screen", "camera") ||
         load_require(ctx, ref, "gridresolution", "camera"))

@@ -69,6 +69,15 @@ zt_status load_fail(load_ctx *ctx, jref ref, const char *fmt, ...)
     return s;
 }
 
+zt_status load_fail_status(load_ctx *ctx, zt_status status, jref ref, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    zt_status s = vfail(ctx, status, ref_offset(ctx, ref), fmt, ap);
+    va_end(ap);
+    return s;
+}
+
 zt_status load_fail_key(load_ctx *ctx, const json_t *obj, const char *key,
                         const char *fmt, ...)
 {

@@ -11,6 +11,8 @@
 
 typedef struct load_ctx {
     const char *name;             /* file name for messages */
+    const char *dir;              /* the folder model files are relative to
+                                     ("" for the current one) */
     const source_map *map;
     const json_positions *positions;
     zt_error *err;
@@ -34,6 +36,10 @@ jref jref_element(const json_t *array, size_t index);
  * member, at its object) and returns ZT_ERR_PARSE. */
 zt_status load_fail(load_ctx *ctx, jref ref, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+
+/* The same with another status (a model file that cannot be read). */
+zt_status load_fail_status(load_ctx *ctx, zt_status status, jref ref, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
 
 /* The same at the key of a member (for unknown keys). */
 zt_status load_fail_key(load_ctx *ctx, const json_t *obj, const char *key,

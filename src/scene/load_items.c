@@ -214,6 +214,8 @@ static zt_status load_item(load_ctx *ctx, jref item)
         return load_sky(ctx, item, body);
     if (strcmp(key, "thing") == 0 || strcmp(key, "light") == 0)
         return load_group(ctx, body, key[0] == 'l', line);
+    if (strcmp(key, "mesh") == 0)
+        return load_mesh_item(ctx, item, body, line);
     if (strcmp(key, "camera") == 0)
         return load_fail_key(ctx, item.value, key, "misplaced camera: it "
                              "belongs at the top level, beside \"scene\"");

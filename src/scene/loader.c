@@ -8,12 +8,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #include "scene/json_positions.h"
 #include "scene/legacy_syntax.h"
 #include "scene/load_context.h"
 #include "scene/load_values.h"
+#include "scene/model_import.h"
+#include "scene/model_scene.h"
 #include "scene/scene_reader.h"
 #include "scene/source_map.h"
 #include "util/error.h"
@@ -54,14 +57,14 @@ static zt_status load_top_level(load_ctx *ctx, const json_t *root)
 }
 
 /* The stages after the rewrite.  *scene is built in place. */
-static zt_status load_parsed(const char *name, const char *original,
+static zt_status load_parsed(const char *name, const char *dir, const char *original,
                              size_t length, const legacy_text *strict,
                              zt_scene *scene, zt_error *err)
 {
     source_map map;
     if (!source_map_init(&map, original, length, strict))
         return zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", name);
-    load_ctx ctx = {name, &map, NULL, err, scene};
+    load_ctx ctx = {name, dir, &map, NULL, err, scene};
     json_error_t jerr;
     json_t *root = json_loadb(strict->text, strict->length,
                               JSON_REJECT_DUPLICATES | JSON_DECODE_ANY, &jerr);
@@ -105,9 +108,9 @@ static zt_status check_nul(const char *name, const char *text, size_t length,
                    "(it is not a text file?)", name, line, column);
 }
 
-zt_status zt_scene_load_string(const char *text, size_t length,
-                               const char *name, zt_scene **out,
-                               zt_error *err)
+/* Loads text; model files are looked for relative to dir. */
+static zt_status load_text(const char *text, size_t length, const char *name,
+                           const char *dir, zt_scene **out, zt_error *err)
 {
     zt_error_clear(err);
     if (!out || (!text && length))
@@ -142,7 +145,7 @@ zt_status zt_scene_load_string(const char *text, size_t length,
     } else if (!(scene = scene_create())) {
         status = zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", name);
     } else {
-        status = load_parsed(name, text, length, &strict, scene, err);
+        status = load_parsed(name, dir, text, length, &strict, scene, err);
     }
     legacy_free(&strict);
     if (status) {
@@ -153,17 +156,41 @@ zt_status zt_scene_load_string(const char *text, size_t length,
     return ZT_OK;
 }
 
+zt_status zt_scene_load_string(const char *text, size_t length,
+                               const char *name, zt_scene **out,
+                               zt_error *err)
+{
+    return load_text(text, length, name, "", out, err);
+}
+
 zt_status zt_scene_load_file(const char *path, zt_scene **out, zt_error *err)
 {
     zt_error_clear(err);
     if (!path || !out)
         return zt_fail(err, ZT_ERR_ARGUMENT, "zt_scene_load_file: no path or no result pointer");
     *out = NULL;
+    /* A model file alone is a scene too. */
+    const char *ext = strrchr(path, '.');
+    if (model_import_known_extension(path) && !(ext && strcasecmp(ext, ".json") == 0))
+        return scene_from_model(path, out, err);
     char *text = NULL;
     size_t length = 0;
     zt_status status = read_text_file(path, "scene file", MAX_SCENE_BYTES, &text, &length, err);
-    if (!status)
-        status = zt_scene_load_string(text, length, path, out, err);
+    if (!status) {
+        /* Model files are relative to the scene file's folder. */
+        char *dir = strdup(path);
+        if (!dir) {
+            free(text);
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+        }
+        char *slash = strrchr(dir, '/');
+        if (slash)
+            slash[1] = '\0';
+        else
+            dir[0] = '\0';
+        status = load_text(text, length, path, dir, out, err);
+        free(dir);
+    }
     free(text);
     return status;
 }

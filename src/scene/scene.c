@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/mesh.h"
 #include "util/error.h"
 
 zt_scene *scene_create(void)
@@ -17,6 +18,9 @@ void zt_scene_release(zt_scene *scene)
         return;
     free(scene->objects);
     free(scene->parts);
+    for (int i = 0; i < scene->mesh_count; i++)
+        mesh_release(scene->meshes[i]);
+    free(scene->meshes);
     free(scene);
 }
 
@@ -45,7 +49,29 @@ int scene_add_object(zt_scene *scene, const object *obj)
     o->index = obj->is_light ? scene->light_count++ : scene->thing_count++;
     o->first_part = scene->part_count;
     o->part_count = 0;
+    o->mesh = -1;
     return scene->object_count++;
+}
+
+int scene_add_mesh_object(zt_scene *scene, const object *obj, struct mesh *m)
+{
+    if (!grow((void **)&scene->meshes, &scene->mesh_capacity, scene->mesh_count + 1,
+              sizeof(struct mesh *)))
+        return -1;
+    int i = scene_add_object(scene, obj);
+    if (i < 0)
+        return -1;
+    scene->meshes[scene->mesh_count] = m;
+    scene->objects[i].mesh = scene->mesh_count++;
+    return i;
+}
+
+long long scene_mesh_triangles(const zt_scene *scene)
+{
+    long long n = 0;
+    for (int i = 0; i < scene->mesh_count; i++)
+        n += scene->meshes[i]->triangle_count;
+    return n;
 }
 
 int scene_add_part(zt_scene *scene, const part *p)
@@ -79,8 +105,11 @@ zt_scene *zt_scene_clone(const zt_scene *scene)
     *c = *scene;
     c->objects = NULL;
     c->parts = NULL;
+    c->meshes = NULL;
+    c->mesh_count = 0;
     c->object_capacity = scene->object_count;
     c->part_capacity = scene->part_count;
+    c->mesh_capacity = scene->mesh_count;
     if (scene->object_count) {
         c->objects = malloc((size_t)scene->object_count * sizeof(object));
         if (c->objects)
@@ -91,7 +120,14 @@ zt_scene *zt_scene_clone(const zt_scene *scene)
         if (c->parts)
             memcpy(c->parts, scene->parts, (size_t)scene->part_count * sizeof(part));
     }
-    if ((scene->object_count && !c->objects) || (scene->part_count && !c->parts)) {
+    if (scene->mesh_count) {
+        c->meshes = malloc((size_t)scene->mesh_count * sizeof *c->meshes);
+        if (c->meshes)
+            for (; c->mesh_count < scene->mesh_count; c->mesh_count++)
+                c->meshes[c->mesh_count] = mesh_retain(scene->meshes[c->mesh_count]);
+    }
+    if ((scene->object_count && !c->objects) || (scene->part_count && !c->parts) ||
+        (scene->mesh_count && !c->meshes)) {
         zt_scene_release(c);
         return NULL;
     }
@@ -115,6 +151,23 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
         case SHAPE_PLANE: out->planes++; break;
         case SHAPE_TRIANGLE: out->triangles++; break;
         case SHAPE_POINT: out->points++; break;
+        }
+    }
+    for (int i = 0; i < scene->object_count; i++) {
+        const object *o = &scene->objects[i];
+        if (o->mesh < 0)
+            continue;
+        const struct mesh *m = scene->meshes[o->mesh];
+        out->meshes++;
+        out->mesh_triangles += m->triangle_count;
+        out->skipped_triangles += m->skipped_degenerate;
+        out->rough_materials += m->rough_slots;
+        for (int t = 0; t < m->triangle_count; t++) {
+            int light = o->is_light || !v3_is_black(m->slots[mesh_slot_of(m, t)].emission);
+            if (light)
+                out->light_parts++;
+            else
+                out->thing_parts++;
         }
     }
 }
@@ -165,6 +218,13 @@ zt_status zt_scene_translate_object(zt_scene *scene, zt_object_class cls,
     if (!o)
         return ZT_ERR_ARGUMENT;
     vec3 d = v3_from(delta);
+    if (o->mesh >= 0) {
+        const double a[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        if (!mesh_make_unique(&scene->meshes[o->mesh]))
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory moving a mesh");
+        mesh_transform(scene->meshes[o->mesh], a, delta);
+        return ZT_OK;
+    }
     for (int i = 0; i < o->part_count; i++) {
         part *p = &scene->parts[o->first_part + i];
         for (int k = 0; k < 3; k++)
@@ -184,6 +244,20 @@ zt_status zt_scene_rotate_object(zt_scene *scene, zt_object_class cls,
     object *o = find_or_fail(scene, cls, index, err);
     if (!o)
         return ZT_ERR_ARGUMENT;
+    if (o->mesh >= 0) {
+        double a[9];
+        for (int c = 0; c < 3; c++) {
+            vec3 e = v3_rotate_axis(v3(c == 0, c == 1, c == 2), axis, angle);
+            a[0 + c] = e.x;
+            a[3 + c] = e.y;
+            a[6 + c] = e.z;
+        }
+        const double t[3] = {0, 0, 0};
+        if (!mesh_make_unique(&scene->meshes[o->mesh]))
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory moving a mesh");
+        mesh_transform(scene->meshes[o->mesh], a, t);
+        return ZT_OK;
+    }
     for (int i = 0; i < o->part_count; i++) {
         part *p = &scene->parts[o->first_part + i];
         for (int k = 0; k < 3; k++)
@@ -201,6 +275,13 @@ zt_status zt_scene_object_position(const zt_scene *scene, zt_object_class cls,
     object *o = find_or_fail((zt_scene *)scene, cls, index, err);
     if (!o)
         return ZT_ERR_ARGUMENT;
+    if (o->mesh >= 0) {
+        /* The centre of the mesh's box: one point, cheap for big meshes. */
+        vec3 lo, hi;
+        mesh_bounds(scene->meshes[o->mesh], &lo, &hi);
+        v3_store(v3_scale(v3_add(lo, hi), 0.5), out);
+        return ZT_OK;
+    }
     vec3 sum = v3(0, 0, 0);
     for (int i = 0; i < o->part_count; i++) {
         const part *p = &scene->parts[o->first_part + i];

@@ -48,14 +48,22 @@ typedef struct object {
     vec3 emission;   /* lights only: radiance (area lights) or intensity (points) */
     int first_part;  /* parts are contiguous: first_part .. first_part+part_count-1 */
     int part_count;
+    int mesh;        /* index into scene->meshes, -1: none.  A mesh object's
+                        triangles are the mesh's (part_count is 0); a mesh
+                        thing takes its materials from the mesh's slots, a
+                        mesh light is all light triangles of its emission */
     int line;
 } object;
+
+struct mesh;
 
 struct zt_scene {
     object *objects;
     int object_count, object_capacity;
     part *parts;
     int part_count, part_capacity;
+    struct mesh **meshes;    /* shared with copies of the scene (mesh.h) */
+    int mesh_count, mesh_capacity;
     int light_count, thing_count;
     vec3 sky;        /* constant radiance of the background, black by default */
     int has_sky;
@@ -73,6 +81,14 @@ int scene_add_object(zt_scene *scene, const object *obj);
 /* Appends a part to the last object added; returns the part's index or -1
  * when out of memory. */
 int scene_add_part(zt_scene *scene, const part *p);
+
+/* Appends a mesh object (a thing, or a light when is_light) owning one
+ * reference to m; returns the object's index or -1 when out of memory (m
+ * is then not taken). */
+int scene_add_mesh_object(zt_scene *scene, const object *obj, struct mesh *m);
+
+/* Triangles of all meshes. */
+long long scene_mesh_triangles(const zt_scene *scene);
 
 /* The default material of a thing that names none: black diffuse. */
 material material_default(void);

@@ -27,6 +27,13 @@ int shape_kind_is_light(shape_kind kind);
  * object whose keys are all allowed) into *out. */
 zt_status load_shape(load_ctx *ctx, shape_kind kind, jref body, part *out);
 
+/* A "transform" object as p -> a p + t (a row-major). */
+zt_status load_transform(load_ctx *ctx, jref ref, double a[9], double t[3]);
+
+/* The body of a "mesh" item (item is the item, for messages about the
+ * model file); adds one object. */
+zt_status load_mesh_item(load_ctx *ctx, jref item, jref body, int line);
+
 /* The top-level "scene" list: adds every object to ctx->scene. */
 zt_status load_scene_list(load_ctx *ctx, jref ref);
 

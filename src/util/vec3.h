@@ -31,6 +31,7 @@ static inline vec3 v3_min3(vec3 a, vec3 b) { return (vec3){dmin(a.x, b.x), dmin(
 static inline vec3 v3_max3(vec3 a, vec3 b) { return (vec3){dmax(a.x, b.x), dmax(a.y, b.y), dmax(a.z, b.z)}; }
 static inline double v3_max(vec3 a) { return dmax(a.x, dmax(a.y, a.z)); }
 static inline int v3_isfinite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+static inline int v3_is_black(vec3 a) { return a.x <= 0 && a.y <= 0 && a.z <= 0; }
 static inline vec3 v3_from(const double a[3]) { return v3(a[0], a[1], a[2]); }
 static inline void v3_store(vec3 a, double out[3]) { out[0] = a.x; out[1] = a.y; out[2] = a.z; }
 

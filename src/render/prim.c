@@ -1,0 +1,86 @@
+/* Mesh triangles seen as parts, and shading normals and albedo at a hit. */
+#include "render/prim.h"
+
+#include "material/texture.h"
+
+void rs_mesh_part(const rscene *rs, const rs_mesh *mm, int prim, rs_part *out)
+{
+    const uint32_t *v = rs_mesh_tri(mm, prim);
+    vec3f p0 = rs_mesh_vertex(mm, v[0]);
+    out->shape = SHAPE_TRIANGLE;
+    out->object = rs_mesh_object(mm, prim);
+    const rs_object *o = &rs->objects[out->object];
+    out->is_light = o->is_light;
+    out->culled = mm->culled;
+    out->background = mm->background;
+    out->light = -1;
+    out->p0 = p0;
+    out->e1 = f3_sub(rs_mesh_vertex(mm, v[1]), p0);
+    out->e2 = f3_sub(rs_mesh_vertex(mm, v[2]), p0);
+    vec3f c = f3_cross(out->e1, out->e2);
+    float len = f3_length(c);
+    out->n = len > 0.0f ? f3_scale(c, 1.0f / len) : f3(0.0f, 0.0f, 1.0f);
+    out->area = 0.5f * len;
+    f3_basis(out->n, &out->tangent, &out->bitangent);
+    out->radius = 0.0f;
+    out->offset = 0.0f;
+    out->select_pdf = 0.0f;
+    if (o->is_light && rs->light_power > 0.0f) {
+        /* As rscene_build weighs the lights: power = luminance x pi x area
+         * x sides. */
+        float power = f3_luminance(o->emission) * out->area * 3.14159265358979f *
+                      (mm->culled ? 1.0f : 2.0f);
+        out->select_pdf = power / rs->light_power;
+    }
+}
+
+void rs_shade_at(const rscene *rs, int prim, const rs_part *p, const rs_object *m, vec3f x,
+                 vec3f n_facing, rs_shade *out)
+{
+    out->ns = n_facing;
+    out->albedo = m->color;
+    if (prim < rs->part_count)
+        return;
+    const rs_mesh *mm = rs_mesh_of(rs, prim);
+    const uint32_t *v = rs_mesh_tri(mm, prim);
+    float b1, b2;
+    rs_triangle_barycentric(p, x, &b1, &b2);
+    float b0 = 1.0f - b1 - b2;
+    if (m->texture && mm->m->uv) {
+        const float *t0 = mm->m->uv + 2 * (size_t)v[0], *t1 = mm->m->uv + 2 * (size_t)v[1];
+        const float *t2 = mm->m->uv + 2 * (size_t)v[2];
+        float u = b0 * t0[0] + b1 * t1[0] + b2 * t2[0];
+        float w = b0 * t0[1] + b1 * t1[1] + b2 * t2[1];
+        out->albedo = f3_mul(m->color, texture_lookup(m->texture, u, w));
+    }
+    if (!mm->smooth)
+        return;
+    const float *nrm = mm->m->normal;
+    vec3f n0 = f3(nrm[3 * v[0]], nrm[3 * v[0] + 1], nrm[3 * v[0] + 2]);
+    vec3f n1 = f3(nrm[3 * v[1]], nrm[3 * v[1] + 1], nrm[3 * v[1] + 2]);
+    vec3f n2 = f3(nrm[3 * v[2]], nrm[3 * v[2] + 1], nrm[3 * v[2] + 2]);
+    vec3f ns = f3_add(f3_add(f3_scale(n0, b0), f3_scale(n1, b1)), f3_scale(n2, b2));
+    /* The vertex normals belong to the front face: seen from behind, they
+     * turn with the geometric normal. */
+    if (f3_dot(p->n, n_facing) < 0.0f)
+        ns = f3_neg(ns);
+    float len = f3_length(ns);
+    if (!(len > 0.0f))
+        return;
+    ns = f3_scale(ns, 1.0f / len);
+    /* A normal bent to or beyond the geometric horizon (a coarse mesh's
+     * silhouette) is lifted to a small angle above it. */
+    float c = f3_dot(ns, n_facing);
+    const float min_c = 0.01f;
+    if (c < min_c) {
+        vec3f tang = f3_sub(ns, f3_scale(n_facing, c));
+        float tl = f3_length(tang);
+        if (tl > 0.0f) {
+            float s = sqrtf(1.0f - min_c * min_c);
+            ns = f3_add(f3_scale(tang, s / tl), f3_scale(n_facing, min_c));
+        } else {
+            ns = n_facing;
+        }
+    }
+    out->ns = ns;
+}

@@ -1,0 +1,302 @@
+/* Model materials onto the four-weight material (model_materials.h).
+ *
+ * glTF's metallic-roughness model and OBJ's MTL both reach us through
+ * Assimp's material keys.  The mapping keeps what the material model can
+ * show: base colour, metal, glass, emission.  glTF's thin dielectric
+ * specular layer over non-metals (a 4% Fresnel reflection) and roughness
+ * have no lobe here; roughness is counted so -v can say it was ignored. */
+#define _POSIX_C_SOURCE 200809L
+#include "scene/model_materials.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include <assimp/material.h>
+#include <assimp/scene.h>
+#include <assimp/texture.h>
+
+#include "scene/texture_decode.h"
+#include "util/error.h"
+
+/* The refractive index given to metals: Schlick's term with an index this
+ * small is ~1 at every angle, so the base colour is the reflectance, as
+ * glTF defines a metal's. */
+#define METAL_IOR 0.01
+#define GLASS_IOR 1.5
+/* Model files are untrusted: an external texture larger than this is not
+ * read (the decoder has its own limit on the decoded size). */
+#define TEXTURE_FILE_MAX (256L << 20)
+
+static double clamp01(double x)
+{
+    return isfinite(x) ? (x < 0.0 ? 0.0 : x > 1.0 ? 1.0 : x) : 0.0;
+}
+
+static int get_float(const struct aiMaterial *am, const char *key, unsigned type, unsigned index,
+                     double *out)
+{
+    ai_real v;
+    unsigned n = 1;
+    if (aiGetMaterialFloatArray(am, key, type, index, &v, &n) != aiReturn_SUCCESS || n < 1 ||
+        !isfinite(v))
+        return 0;
+    *out = v;
+    return 1;
+}
+
+static int get_color(const struct aiMaterial *am, const char *key, unsigned type, unsigned index,
+                     vec3 *out)
+{
+    struct aiColor4D c;
+    if (aiGetMaterialColor(am, key, type, index, &c) != aiReturn_SUCCESS)
+        return 0;
+    if (!isfinite(c.r) || !isfinite(c.g) || !isfinite(c.b))
+        return 0;
+    *out = v3(c.r, c.g, c.b);
+    return 1;
+}
+
+/* The model file's folder, with a trailing slash ("" for the current one). */
+static void folder_of(const char *path, char *out, size_t n)
+{
+    const char *slash = strrchr(path, '/');
+    size_t len = slash ? (size_t)(slash - path + 1) : 0;
+    if (len >= n)
+        len = 0;
+    memcpy(out, path, len);
+    out[len] = '\0';
+}
+
+static unsigned char *read_whole(const char *file, size_t *size, char *why, size_t n)
+{
+    FILE *fp = fopen(file, "rb");
+    if (!fp) {
+        snprintf(why, n, "cannot be opened");
+        return NULL;
+    }
+    unsigned char *buf = NULL;
+    long len = -1;
+    if (fseek(fp, 0, SEEK_END) == 0)
+        len = ftell(fp);
+    if (len < 0 || len > TEXTURE_FILE_MAX || fseek(fp, 0, SEEK_SET) != 0) {
+        snprintf(why, n, len > TEXTURE_FILE_MAX ? "larger than 256 MB" : "cannot be read");
+        fclose(fp);
+        return NULL;
+    }
+    buf = malloc(len > 0 ? (size_t)len : 1);
+    if (!buf || fread(buf, 1, (size_t)len, fp) != (size_t)len) {
+        snprintf(why, n, buf ? "cannot be read" : "out of memory");
+        free(buf);
+        buf = NULL;
+    }
+    fclose(fp);
+    *size = (size_t)len;
+    return buf;
+}
+
+/* An uncompressed embedded texture: Assimp's texels are BGRA, row 0 at the
+ * top. */
+static int copy_texels(const struct aiTexture *t, mesh_texture *out, char *why, size_t n)
+{
+    if (t->mWidth == 0 || t->mHeight == 0 || t->mWidth > TEXTURE_MAX_SIDE ||
+        t->mHeight > TEXTURE_MAX_SIDE ||
+        (unsigned long long)t->mWidth * t->mHeight > TEXTURE_MAX_TEXELS || !t->pcData) {
+        snprintf(why, n, "embedded texture of %ux%u texels is empty or too large", t->mWidth,
+                 t->mHeight);
+        return 0;
+    }
+    size_t count = (size_t)t->mWidth * t->mHeight;
+    out->rgba = malloc(count * 4);
+    if (!out->rgba) {
+        snprintf(why, n, "out of memory");
+        return 0;
+    }
+    for (size_t i = 0; i < count; i++) {
+        out->rgba[4 * i + 0] = t->pcData[i].r;
+        out->rgba[4 * i + 1] = t->pcData[i].g;
+        out->rgba[4 * i + 2] = t->pcData[i].b;
+        out->rgba[4 * i + 3] = t->pcData[i].a;
+    }
+    out->width = (int)t->mWidth;
+    out->height = (int)t->mHeight;
+    out->wrap = 1;
+    return 1;
+}
+
+/* Decodes the texture the material names ("*N" for the file's embedded
+ * texture N, else a file name relative to the model).  Returns 1, or 0 with
+ * the reason. */
+static int load_texture(const struct aiScene *sc, const char *folder, const char *name,
+                        mesh_texture *out, char *why, size_t n)
+{
+    memset(out, 0, sizeof *out);
+    if (name[0] == '*') {
+        char *end;
+        long k = strtol(name + 1, &end, 10);
+        if (*end || k < 0 || (unsigned long)k >= sc->mNumTextures || !sc->mTextures[k]) {
+            snprintf(why, n, "names embedded texture %s, which the file does not have", name);
+            return 0;
+        }
+        const struct aiTexture *t = sc->mTextures[k];
+        if (t->mHeight != 0)
+            return copy_texels(t, out, why, n);
+        if (!t->pcData) {
+            snprintf(why, n, "embedded texture %s is empty", name);
+            return 0;
+        }
+        return texture_decode((const unsigned char *)t->pcData, t->mWidth, out, why, n);
+    }
+    char file[4096];
+    /* An absolute name is taken as it is; anything else is relative to the
+     * model's folder (OBJ and glTF both mean that). */
+    if (name[0] == '/')
+        snprintf(file, sizeof file, "%s", name);
+    else if ((size_t)snprintf(file, sizeof file, "%s%s", folder, name) >= sizeof file) {
+        snprintf(why, n, "the texture's file name is too long");
+        return 0;
+    }
+    for (char *c = file; *c; c++)
+        if (*c == '\\')
+            *c = '/'; /* models written on Windows */
+    size_t size = 0;
+    char reason[128];
+    unsigned char *data = read_whole(file, &size, reason, sizeof reason);
+    if (!data) {
+        snprintf(why, n, "%s %s", file, reason);
+        return 0;
+    }
+    int ok = texture_decode(data, size, out, reason, sizeof reason);
+    free(data);
+    if (!ok)
+        snprintf(why, n, "%s: %s", file, reason);
+    return ok;
+}
+
+/* The base-colour texture of a material: glTF's base colour, else the
+ * diffuse one (OBJ's map_Kd).  Textures shared by several materials are
+ * decoded once.  Returns the texture index or -1. */
+static int material_texture(const struct aiScene *sc, const struct aiMaterial *am,
+                            const char *folder, mesh *m, char (*names)[256], zt_status *st,
+                            zt_error *err, const char *path)
+{
+    enum aiTextureType types[2] = {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE};
+    for (int i = 0; i < 2; i++) {
+        if (aiGetMaterialTextureCount(am, types[i]) == 0)
+            continue;
+        struct aiString name;
+        enum aiTextureMapMode mode[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
+        if (aiGetMaterialTexture(am, types[i], 0, &name, NULL, NULL, NULL, NULL, mode, NULL) !=
+                aiReturn_SUCCESS ||
+            name.length == 0)
+            continue;
+        for (int k = 0; k < m->texture_count; k++)
+            if (strcmp(names[k], name.data) == 0)
+                return k;
+        mesh_texture tex;
+        char why[sizeof m->texture_problem];
+        if (!load_texture(sc, folder, name.data, &tex, why, sizeof why)) {
+            if (strstr(why, "out of memory")) {
+                *st = zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory for a texture", path);
+                return -1;
+            }
+            if (m->missing_textures++ == 0)
+                snprintf(m->texture_problem, sizeof m->texture_problem, "%s", why);
+            return -1;
+        }
+        tex.wrap = mode[0] != aiTextureMapMode_Clamp && mode[0] != aiTextureMapMode_Decal;
+        int k = m->texture_count++;
+        m->textures[k] = tex;
+        snprintf(names[k], sizeof names[k], "%s", name.data);
+        return k;
+    }
+    return -1;
+}
+
+/* One material of the file as a slot. */
+static void map_material(const struct aiMaterial *am, int gltf, mesh_slot *s)
+{
+    memset(s, 0, sizeof *s);
+    struct aiString name;
+    if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS)
+        snprintf(s->name, sizeof s->name, "%s", name.data);
+    vec3 color = v3(0.8, 0.8, 0.8); /* a material without colour: light grey */
+    if (!get_color(am, AI_MATKEY_BASE_COLOR, &color))
+        get_color(am, AI_MATKEY_COLOR_DIFFUSE, &color);
+    s->mat.color = v3(clamp01(color.x), clamp01(color.y), clamp01(color.z));
+
+    double metallic = 0.0, transmission = 0.0, ior = GLASS_IOR, v;
+    if (get_float(am, AI_MATKEY_METALLIC_FACTOR, &v))
+        metallic = clamp01(v);
+    if (get_float(am, AI_MATKEY_TRANSMISSION_FACTOR, &v))
+        transmission = clamp01(v);
+    /* MTL's dissolve arrives as opacity.  glTF's base-colour alpha arrives
+     * there too, but means coverage (alpha blending), not glass: ignored. */
+    else if (!gltf && get_float(am, AI_MATKEY_OPACITY, &v))
+        transmission = 1.0 - clamp01(v);
+    if (get_float(am, AI_MATKEY_REFRACTI, &v) && v >= 1.0 && v <= 4.0)
+        ior = v;
+    s->mat.weight[LOBE_METALLIC] = metallic;
+    s->mat.weight[LOBE_REFRACTIVE] = (1.0 - metallic) * transmission;
+    s->mat.weight[LOBE_DIFFUSE] = (1.0 - metallic) * (1.0 - transmission);
+    s->mat.weight[LOBE_REFLECTING] = 0.0;
+    /* One index serves both the metallic lobe's Fresnel term and glass. */
+    s->mat.ior = s->mat.weight[LOBE_REFRACTIVE] > 0.0 ? ior : metallic > 0.0 ? METAL_IOR : ior;
+
+    vec3 e = v3(0, 0, 0);
+    if (get_color(am, AI_MATKEY_COLOR_EMISSIVE, &e)) {
+        double k = 1.0;
+        if (get_float(am, AI_MATKEY_EMISSIVE_INTENSITY, &v) && v >= 0.0)
+            k = v;
+        e = v3(fmax(e.x, 0.0) * k, fmax(e.y, 0.0) * k, fmax(e.z, 0.0) * k);
+        if (isfinite(e.x) && isfinite(e.y) && isfinite(e.z))
+            s->emission = e;
+    }
+    if (get_float(am, AI_MATKEY_ROUGHNESS_FACTOR, &v))
+        s->roughness = clamp01(v);
+    s->texture = -1;
+}
+
+static int is_gltf(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    return dot && (strcasecmp(dot, ".gltf") == 0 || strcasecmp(dot, ".glb") == 0);
+}
+
+zt_status model_materials(const struct aiScene *sc, const char *path,
+                          const int *slot_of_material, int slot_count, mesh *m, zt_error *err)
+{
+    m->slots = calloc((size_t)slot_count, sizeof *m->slots);
+    /* At most one texture per slot. */
+    m->textures = calloc((size_t)slot_count, sizeof *m->textures);
+    char(*names)[256] = calloc((size_t)slot_count, sizeof *names);
+    if (!m->slots || !m->textures || !names) {
+        free(names);
+        return zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", path);
+    }
+    m->slot_count = slot_count;
+    for (int s = 0; s < slot_count; s++) {
+        m->slots[s].mat.weight[LOBE_DIFFUSE] = 1.0;
+        m->slots[s].mat.color = v3(0.8, 0.8, 0.8);
+        m->slots[s].mat.ior = 1.0;
+        m->slots[s].texture = -1;
+    }
+    char folder[4096];
+    folder_of(path, folder, sizeof folder);
+    int gltf = is_gltf(path);
+    zt_status st = ZT_OK;
+    for (unsigned i = 0; i < sc->mNumMaterials && st == ZT_OK; i++) {
+        int s = slot_of_material[i];
+        if (s < 0 || s >= slot_count || !sc->mMaterials[i])
+            continue;
+        map_material(sc->mMaterials[i], gltf, &m->slots[s]);
+        m->slots[s].texture = material_texture(sc, sc->mMaterials[i], folder, m, names, &st,
+                                               err, path);
+        if (m->slots[s].roughness > 0.0)
+            m->rough_slots++;
+    }
+    free(names);
+    return st;
+}

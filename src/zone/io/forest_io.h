@@ -1,0 +1,34 @@
+/* The forest on disk: a versioned little-endian binary file holding what
+ * Phase One computes (zones, the nodes' irradiance), tied to the scene and
+ * to the options that shape the forest by hashes.  The format is
+ * documented in docs/zone-tracer.md ("The forest file"). */
+#ifndef ZT_ZONE_FOREST_IO_H
+#define ZT_ZONE_FOREST_IO_H
+
+#include "zone/zone.h"
+
+/* 12: the forest of nodes (docs/zone-tracer.md): zones per surface, lobe
+ * and level, and the irradiance of every node. */
+#define FOREST_FILE_VERSION 12
+
+/* Writes f (the forest of renderer r) to path, through a temporary file
+ * renamed into place. */
+zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *path,
+                      zt_error *err);
+
+/* Reads the forest for renderer r (its scene and options) from path into f
+ * (zeroed).  expect holds the quality settings r would build with: the
+ * file's must match in everything but the texel size, which depends on the
+ * camera the forest was built with and is taken from the file. */
+zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *expect,
+                      const char *path, zt_error *err);
+
+/* 64-bit FNV-1a of the scene's geometry, materials, lights and sky (not
+ * the camera), meshes and their textures included. */
+uint64_t forest_scene_hash(const zt_scene *sc);
+
+/* Bytes held by the zones, the nodes, their irradiance and the occluder
+ * index. */
+uint64_t forest_memory(const zone_forest *f);
+
+#endif

@@ -1,0 +1,565 @@
+#include "zone/light/direct.h"
+
+#include <string.h>
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "util/vec3_convert.h"
+#include "zone/light/lambert.h"
+#include "zone/light/poly2.h"
+#include "zone/light/zprim.h"
+
+#define MAX_PIECES 192
+#define POLY3_MAX 48
+
+/* The plane the light's polygon lies on, with a 2D frame. */
+typedef struct light_frame {
+    vec3 origin, u, v, n;
+    double hx;     /* signed height of the shaded point above the plane */
+} light_frame;
+
+typedef struct poly3 {
+    int n;
+    vec3 p[POLY3_MAX];
+} poly3;
+
+static double height(const light_frame *f, vec3 p)
+{
+    return v3_dot(f->n, v3_sub(p, f->origin));
+}
+
+/* Keeps the part of a 3D polygon where a.p + b >= 0. */
+static void poly3_clip(poly3 *poly, vec3 a, double b)
+{
+    poly3 out;
+    out.n = 0;
+    if (poly->n == 0)
+        return;
+    int j = poly->n - 1;
+    double dj = v3_dot(a, poly->p[j]) + b;
+    for (int i = 0; i < poly->n; i++) {
+        double di = v3_dot(a, poly->p[i]) + b;
+        if ((dj >= 0) != (di >= 0) && out.n < POLY3_MAX) {
+            double t = dj / (dj - di);
+            out.p[out.n++] = v3_add(poly->p[j], v3_scale(v3_sub(poly->p[i], poly->p[j]), t));
+        }
+        if (di >= 0 && out.n < POLY3_MAX)
+            out.p[out.n++] = poly->p[i];
+        j = i;
+        dj = di;
+    }
+    *poly = out;
+}
+
+/* Orthonormal u, v around unit n. */
+static void basis(vec3 n, vec3 *u, vec3 *v)
+{
+    vec3 a = fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0);
+    *u = v3_normalize(v3_cross(a, n));
+    *v = v3_cross(n, *u);
+}
+
+/* Projects the occluding polygon from x onto the light plane and cuts it
+ * out of the pieces.  beyond: parts past the light plane block too (a
+ * background light behind foreground objects). */
+static void cut_shadow(const light_frame *f, vec3 x, poly3 *occ, int beyond,
+                       poly2_set *set, poly2 *scratch)
+{
+    double s = f->hx > 0 ? 1.0 : -1.0, hx = fabs(f->hx);
+    /* Keep what is nearer the plane than x (s*h < hx) and, unless beyond,
+     * on x's side of it (s*h > 0). */
+    poly3_clip(occ, v3_scale(f->n, -s), s * v3_dot(f->n, f->origin) + hx * (1.0 - 1e-9));
+    if (!beyond)
+        poly3_clip(occ, v3_scale(f->n, s), -s * v3_dot(f->n, f->origin) - hx * 1e-9);
+    if (occ->n < 3)
+        return;
+    poly2 hole;
+    hole.n = 0;
+    for (int i = 0; i < occ->n && hole.n < POLY2_MAX; i++) {
+        double h = height(f, occ->p[i]);
+        double t = f->hx / (f->hx - h);
+        vec3 q = v3_add(x, v3_scale(v3_sub(occ->p[i], x), t));
+        vec3 d = v3_sub(q, f->origin);
+        hole.x[hole.n] = v3_dot(d, f->u);
+        hole.y[hole.n] = v3_dot(d, f->v);
+        hole.n++;
+    }
+    if (fabs(poly2_area(&hole)) <= 0.0)
+        return;
+    poly2_make_ccw(&hole);
+    poly2_set_subtract(set, &hole, scratch);
+}
+
+/* A disk (centre c, unit normal w, radius r) as a polygon of equal area. */
+static void disk_polygon(vec3 c, vec3 w, double r, int sides, poly3 *out)
+{
+    vec3 u, v;
+    basis(w, &u, &v);
+    if (sides > POLY3_MAX)
+        sides = POLY3_MAX;
+    double step = 2.0 * 3.14159265358979323846 / sides;
+    double re = r * sqrt(step / sin(step)); /* same area as the disk */
+    out->n = sides;
+    for (int i = 0; i < sides; i++)
+        out->p[i] = v3_add(c, v3_add(v3_scale(u, re * cos(i * step)),
+                                     v3_scale(v, re * sin(i * step))));
+}
+
+/* The silhouette of a sphere seen from x: the circle where the tangent cone
+ * touches it.  Returns 0 when x is inside. */
+static int sphere_silhouette(vec3 centre, double r, vec3 x, vec3 *c, vec3 *w,
+                             double *rs)
+{
+    vec3 d = v3_sub(centre, x);
+    double dist = v3_length(d);
+    if (dist <= r)
+        return 0;
+    *w = v3_scale(d, 1.0 / dist);
+    *c = v3_sub(centre, v3_scale(*w, r * r / dist));
+    *rs = r * sqrt(1.0 - (r * r) / (dist * dist));
+    return 1;
+}
+
+/* Points of the circle where plane (pn . p = po) meets the sphere. */
+static int circle_points(vec3 centre, double r, vec3 pn, double po, int k, vec3 *out)
+{
+    double d = v3_dot(pn, centre) - po;
+    if (fabs(d) >= r)
+        return 0;
+    vec3 c = v3_sub(centre, v3_scale(pn, d)), u, v;
+    double rr = sqrt(r * r - d * d);
+    basis(pn, &u, &v);
+    for (int i = 0; i < k; i++) {
+        double a = 2.0 * 3.14159265358979323846 * i / k;
+        out[i] = v3_add(c, v3_add(v3_scale(u, rr * cos(a)), v3_scale(v, rr * sin(a))));
+    }
+    return k;
+}
+
+/* The shadow of a sphere that crosses the light's plane or the level of
+ * x: the projection of the convex part of the sphere between them, whose
+ * outline comes from the silhouette (where it lies between), the circle on
+ * the light's plane, and the circle at x's level (just inside it). */
+static void sphere_cut(const direct_ctx *c, const light_frame *f, vec3 x, const zprim *o,
+                       vec3 sc, vec3 sw, double sr, poly2_set *set, poly2 *scratch)
+{
+    enum { K = 24 };
+    vec3 pts[POLY3_MAX + 2 * K];
+    int n = 0;
+    double s = f->hx > 0 ? 1.0 : -1.0, hx = fabs(f->hx);
+    poly3 sil;
+    disk_polygon(sc, sw, sr, K < c->sides ? c->sides : K, &sil);
+    for (int i = 0; i < sil.n; i++) {
+        double h = s * height(f, sil.p[i]);
+        if (h > 0 && h < hx)
+            pts[n++] = sil.p[i];
+    }
+    double po = v3_dot(f->n, f->origin);
+    n += circle_points(o->p[0], o->radius, f->n, po, K, pts + n);
+    n += circle_points(o->p[0], o->radius, f->n, po + s * hx * (1.0 - 1e-3), K, pts + n);
+    if (n < 3)
+        return;
+    double xs[POLY3_MAX + 2 * K], ys[POLY3_MAX + 2 * K];
+    for (int i = 0; i < n; i++) {
+        double h = height(f, pts[i]);
+        double t = f->hx / (f->hx - h);
+        vec3 q = v3_add(x, v3_scale(v3_sub(pts[i], x), t));
+        vec3 d = v3_sub(q, f->origin);
+        xs[i] = v3_dot(d, f->u);
+        ys[i] = v3_dot(d, f->v);
+    }
+    poly2 hole;
+    poly2_hull(xs, ys, n, &hole);
+    if (hole.n >= 3)
+        poly2_set_subtract(set, &hole, scratch);
+}
+
+/* Cuts the shadow of part `o` (seen from x) out of the light's pieces.
+ * Returns 1 when x is wholly enclosed (inside an opaque sphere). */
+/* The pyramid from x through the light's polygon: a triangle wholly
+ * outside one of its side planes casts no shadow on the light. */
+#define FRUSTUM_MAX 16
+typedef struct frustum {
+    int n;                   /* 0: no test */
+    vec3 normal[FRUSTUM_MAX];/* inward normals of the planes through x */
+} frustum;
+
+static int outside_frustum(const frustum *fr, vec3 x, const vec3 *p, int count)
+{
+    for (int k = 0; k < fr->n; k++) {
+        int out = 1;
+        for (int i = 0; i < count && out; i++)
+            out = v3_dot(fr->normal[k], v3_sub(p[i], x)) < 0;
+        if (out)
+            return 1;
+    }
+    return 0;
+}
+
+static int occlude_with(const direct_ctx *c, const light_frame *f, vec3 x,
+                        vec3 n, const zprim *o, int beyond,
+                        const frustum *fr, poly2_set *set, poly2 *scratch)
+{
+    poly3 poly;
+    switch (o->shape) {
+    case SHAPE_TRIANGLE: {
+        if (outside_frustum(fr, x, o->p, 3))
+            return 0;
+        vec3 nt = v3_cross(v3_sub(o->p[1], o->p[0]), v3_sub(o->p[2], o->p[0]));
+        /* A culled triangle lets rays from behind through. */
+        if (o->culled && v3_dot(nt, v3_sub(x, o->p[0])) <= 0)
+            return 0;
+        int above = 0;
+        for (int i = 0; i < 3; i++)
+            above |= v3_dot(n, v3_sub(o->p[i], x)) > 0;
+        if (!above)
+            return 0;
+        poly.n = 3;
+        for (int i = 0; i < 3; i++)
+            poly.p[i] = o->p[i];
+        break;
+    }
+    case SHAPE_SPHERE: {
+        vec3 sc, sw;
+        double sr;
+        if (!sphere_silhouette(o->p[0], o->radius, x, &sc, &sw, &sr))
+            return !o->culled; /* inside: opaque unless culled */
+        if (v3_dot(n, v3_sub(o->p[0], x)) <= -o->radius)
+            return 0;
+        double hc = height(f, o->p[0]), s = f->hx > 0 ? 1.0 : -1.0;
+        if (!beyond && (s * hc - o->radius <= 0 || s * hc + o->radius >= fabs(f->hx))) {
+            /* The sphere crosses the light's plane or x's level: its shadow
+             * is the projection of the part between them. */
+            sphere_cut(c, f, x, o, sc, sw, sr, set, scratch);
+            return 0;
+        }
+        disk_polygon(sc, sw, sr, c->sides, &poly);
+        break;
+    }
+    case SHAPE_PLANE: {
+        double sx = v3_dot(o->normal, x) - o->offset;
+        if (o->culled && sx <= 0)
+            return 0;
+        /* Points q of the light plane whose segment from x crosses this
+         * plane are hidden: keep the side of x. */
+        double s = sx > 0 ? 1.0 : -1.0;
+        double a = s * v3_dot(o->normal, f->u), b = s * v3_dot(o->normal, f->v);
+        double k = s * (v3_dot(o->normal, f->origin) - o->offset);
+        if (beyond)
+            return 0; /* background light behind a foreground plane: rare, left out */
+        for (int i = 0; i < set->count; i++)
+            poly2_clip(&set->piece[i], a, b, k);
+        return 0;
+    }
+    default:
+        return 0;
+    }
+    cut_shadow(f, x, &poly, beyond, set, scratch);
+    return 0;
+}
+
+/* The light's polygon on its plane as seen from x, in the frame's 2D
+ * coordinates.  Returns 0 when x sees no side of it that emits. */
+static int light_polygon(const direct_ctx *c, int light, vec3 x, light_frame *f,
+                         poly2 *out)
+{
+    zprim lpp;
+    zprim_get(c->scene, c->rs, light, &lpp);
+    const zprim *lp = &lpp;
+    poly3 light_poly;
+    if (lp->shape == SHAPE_TRIANGLE) {
+        vec3 nl = v3_normalize(v3_cross(v3_sub(lp->p[1], lp->p[0]), v3_sub(lp->p[2], lp->p[0])));
+        if (lp->culled && v3_dot(nl, v3_sub(x, lp->p[0])) <= 0)
+            return 0;
+        f->origin = lp->p[0];
+        f->n = nl;
+        light_poly.n = 3;
+        for (int i = 0; i < 3; i++)
+            light_poly.p[i] = lp->p[i];
+    } else if (lp->shape == SHAPE_SPHERE) {
+        vec3 dc, w;
+        double dr;
+        if (!sphere_silhouette(lp->p[0], lp->radius, x, &dc, &w, &dr))
+            return 0; /* inside a light sphere: not handled here */
+        f->origin = dc;
+        f->n = w;
+        disk_polygon(dc, w, dr, c->sides, &light_poly);
+    } else {
+        return 0; /* light planes: not handled by the direct term */
+    }
+    basis(f->n, &f->u, &f->v);
+    f->hx = height(f, x);
+    if (fabs(f->hx) <= 1e-12)
+        return 0;
+    out->n = light_poly.n;
+    for (int i = 0; i < light_poly.n; i++) {
+        vec3 d = v3_sub(light_poly.p[i], f->origin);
+        out->x[i] = v3_dot(d, f->u);
+        out->y[i] = v3_dot(d, f->v);
+    }
+    poly2_make_ccw(out);
+    return 1;
+}
+
+static vec3 lift(const light_frame *f, double a, double b)
+{
+    return v3_add(f->origin, v3_add(v3_scale(f->u, a), v3_scale(f->v, b)));
+}
+
+/* Cuts the shadows of every primitive but the receiver and the light out
+ * of the pieces.  Returns 1 when done, 0 when x is enclosed and sees
+ * nothing, -1 when more occluders stand in the way than clipping takes
+ * (the caller then sees the light by rays). */
+static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, vec3 x,
+                         vec3 n, int receiver, poly2_set *set, poly2 *scratch)
+{
+    const zt_scene *sc = c->scene;
+    zprim lpp;
+    zprim_get(sc, c->rs, light, &lpp);
+    /* Only what meets the box around x and the light can cast a shadow. */
+    occ_region region;
+    region.lo = x;
+    region.hi = x;
+    region.planes = 0;
+    for (int k = 0; k < set->count; k++)
+        for (int i = 0; i < set->piece[k].n; i++) {
+            vec3 q = lift(f, set->piece[k].x[i], set->piece[k].y[i]);
+            region.lo = v3_min3(region.lo, q);
+            region.hi = v3_max3(region.hi, q);
+        }
+    /* Side planes of the pyramid from x through the (one, convex) light
+     * polygon, facing inward; background lights are blocked beyond it
+     * too, which the pyramid does not bound, so they skip the test. */
+    frustum fr = {0, {{0, 0, 0}}};
+    const poly2 *lp = &set->piece[0];
+    if (set->count == 1 && lp->n >= 3 && lp->n <= FRUSTUM_MAX && !lpp.background) {
+        vec3 q0 = lift(f, lp->x[lp->n - 1], lp->y[lp->n - 1]), inside = v3(0, 0, 0);
+        for (int i = 0; i < lp->n; i++)
+            inside = v3_add(inside, lift(f, lp->x[i], lp->y[i]));
+        inside = v3_scale(inside, 1.0 / lp->n);
+        for (int i = 0; i < lp->n; i++) {
+            vec3 q1 = lift(f, lp->x[i], lp->y[i]);
+            vec3 nn = v3_cross(v3_sub(q0, x), v3_sub(q1, x));
+            if (v3_dot(nn, v3_sub(inside, x)) < 0)
+                nn = v3_scale(nn, -1);
+            fr.normal[fr.n++] = nn;
+            if (region.planes < OCC_PLANES_MAX) {
+                region.n[region.planes] = nn;
+                region.d[region.planes++] = -v3_dot(nn, x);
+            }
+            q0 = q1;
+        }
+    }
+    if (lpp.background) {
+        /* Foreground primitives beyond the light hide it too. */
+        region.lo = v3(-INFINITY, -INFINITY, -INFINITY);
+        region.hi = v3(INFINITY, INFINITY, INFINITY);
+    }
+    /* Infinite planes are few and in no index. */
+    for (int i = 0; i < sc->part_count; i++) {
+        if (i == receiver || i == light || sc->parts[i].shape != SHAPE_PLANE)
+            continue;
+        zprim o;
+        zprim_get(sc, c->rs, i, &o);
+        if (o.background && !lpp.background)
+            continue;
+        int beyond = lpp.background && !o.background;
+        if (occlude_with(c, f, x, n, &o, beyond, &fr, set, scratch))
+            return 0;
+    }
+    int32_t cand[DIRECT_MAX_OCCLUDERS];
+    int found = occluders_query(c->occ, &region, cand, DIRECT_MAX_OCCLUDERS);
+    if (found > DIRECT_MAX_OCCLUDERS)
+        return -1;
+    for (int k = 0; k < found; k++) {
+        int i = cand[k];
+        if (i == receiver || i == light)
+            continue;
+        zprim o;
+        zprim_get(sc, c->rs, i, &o);
+        /* The background rule: background objects block foreground lights
+         * never; foreground objects block background lights even beyond. */
+        if (o.background && !lpp.background)
+            continue;
+        int beyond = lpp.background && !o.background;
+        if (occlude_with(c, f, x, n, &o, beyond, &fr, set, scratch))
+            return 0;
+    }
+    return set->overflow ? -1 : 1;
+}
+
+/* The irradiance of polygon piece p (on the light's plane) at x, with
+ * visibility by rays: p is cut into triangles of about 1/count of the
+ * light each, and each counts if a ray from x reaches its centre. */
+static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p, vec3 x, vec3 n,
+                      int background, int count)
+{
+    /* Fan triangles, each cut into 4^k by midpoints. */
+    int fan = p->n - 2, k = 0;
+    while (fan * (1 << (2 * k)) < count && k < 6)
+        k++;
+    int m = 1 << k;
+    vec3f xo = ray_offset(v3_to_f3(x), v3_to_f3(n));
+    double e = 0;
+    vec3 a = lift(f, p->x[0], p->y[0]);
+    for (int t = 1; t + 1 < p->n; t++) {
+        vec3 b = lift(f, p->x[t], p->y[t]), cc = lift(f, p->x[t + 1], p->y[t + 1]);
+        vec3 e1 = v3_scale(v3_sub(b, a), 1.0 / m), e2 = v3_scale(v3_sub(cc, a), 1.0 / m);
+        for (int j = 0; j < m; j++)
+            for (int i = 0; i + j < m; i++)
+                for (int up = 0; up < 2; up++) {
+                    if (up && i + j + 1 >= m)
+                        continue;
+                    vec3 q[3];
+                    vec3 base = v3_add(a, v3_add(v3_scale(e1, i), v3_scale(e2, j)));
+                    if (!up) {
+                        q[0] = base;
+                        q[1] = v3_add(base, e1);
+                        q[2] = v3_add(base, e2);
+                    } else {
+                        q[0] = v3_add(base, e1);
+                        q[1] = v3_add(v3_add(base, e1), e2);
+                        q[2] = v3_add(base, e2);
+                    }
+                    double g = lambert_polygon(x, n, q, 3);
+                    if (!(g > 0))
+                        continue;
+                    vec3 ctr = v3_scale(v3_add(v3_add(q[0], q[1]), q[2]), 1.0 / 3.0);
+                    vec3f to = f3_sub(v3_to_f3(ctr), xo);
+                    float dist = f3_length(to);
+                    if (!(dist > 0.0f))
+                        continue;
+                    if (!accel_occluded(c->rs, xo, f3_scale(to, 1.0f / dist), dist * 0.9999f,
+                                        background))
+                        e += g;
+                }
+    }
+    return e;
+}
+
+double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
+                         int receiver)
+{
+    zprim lpp;
+    zprim_get(c->scene, c->rs, light, &lpp);
+    const zprim *lp = &lpp;
+
+    if (lp->shape == SHAPE_POINT) {
+        vec3 d = v3_sub(lp->p[0], x);
+        double d2 = v3_dot(d, d), cosx = v3_dot(n, d) / sqrt(d2);
+        if (cosx <= 0)
+            return 0;
+        vec3f xf = f3((float)x.x, (float)x.y, (float)x.z);
+        vec3f nf = f3((float)n.x, (float)n.y, (float)n.z);
+        vec3f df = f3((float)d.x, (float)d.y, (float)d.z);
+        float dist = f3_length(df);
+        if (accel_occluded(c->rs, ray_offset(xf, nf), f3_scale(df, 1.0f / dist),
+                           dist * 0.9999f, lp->background))
+            return 0;
+        return cosx / d2;
+    }
+
+    light_frame f;
+    poly2 pieces[MAX_PIECES], scratch;
+    poly2_set set = {pieces, 1, MAX_PIECES, 0};
+    if (!light_polygon(c, light, x, &f, &pieces[0]))
+        return 0;
+    /* Above x's horizon only. */
+    poly2_clip(&pieces[0], v3_dot(n, f.u), v3_dot(n, f.v), v3_dot(n, v3_sub(f.origin, x)));
+    if (pieces[0].n < 3)
+        return 0;
+    poly2 whole = pieces[0];
+    int cut = cut_occluders(c, light, &f, x, n, receiver, &set, &scratch);
+    if (cut < 0)
+        return by_rays(c, &f, &whole, x, n, lp->background, c->fallback);
+    if (cut == 0)
+        return 0;
+    double e = 0;
+    for (int k = 0; k < set.count; k++) {
+        const poly2 *p = &set.piece[k];
+        if (p->n < 3)
+            continue;
+        vec3 q[POLY2_MAX];
+        for (int i = 0; i < p->n; i++)
+            q[i] = lift(&f, p->x[i], p->y[i]);
+        e += lambert_polygon(x, n, q, p->n);
+    }
+    return e;
+}
+
+/* Where the line from a through b meets the plane (pn, po). */
+static vec3 through_plane(vec3 a, vec3 b, vec3 pn, double po)
+{
+    vec3 d = v3_sub(b, a);
+    double t = (po - v3_dot(pn, a)) / v3_dot(pn, d);
+    return v3_add(a, v3_scale(d, t));
+}
+
+double direct_pixel_coverage(const direct_ctx *ctx, int light, vec3 eye,
+                             const vec3 corner[4])
+{
+    /* Outlines of spheres as fine as polygons go: a light seen directly is
+     * the brightest thing in the image, and its edge pixels show every
+     * sliver a coarse outline gets wrong. */
+    direct_ctx fine = *ctx;
+    fine.sides = 32;
+    const direct_ctx *c = &fine;
+    light_frame f;
+    poly2 pieces[MAX_PIECES], scratch;
+    poly2_set set = {pieces, 1, MAX_PIECES, 0};
+    zprim lpp;
+    zprim_get(c->scene, c->rs, light, &lpp);
+    if (lpp.shape == SHAPE_POINT || !light_polygon(c, light, eye, &f, &pieces[0]))
+        return 0;
+    /* The pixel's footprint on the light's plane: its corners seen from the
+     * eye.  The corners run around the pixel, so the quad is convex. */
+    poly2 quad;
+    quad.n = 4;
+    for (int i = 0; i < 4; i++) {
+        vec3 q = through_plane(eye, corner[i], f.n, v3_dot(f.n, f.origin));
+        vec3 d = v3_sub(q, f.origin);
+        quad.x[i] = v3_dot(d, f.u);
+        quad.y[i] = v3_dot(d, f.v);
+    }
+    poly2_make_ccw(&quad);
+    for (int i = 0, j = quad.n - 1; i < quad.n; j = i++) {
+        double a = quad.y[j] - quad.y[i], b = quad.x[i] - quad.x[j];
+        poly2_clip(&pieces[0], a, b, -(a * quad.x[j] + b * quad.y[j]));
+    }
+    if (pieces[0].n < 3)
+        return 0;
+    /* The eye sees with no horizon: a normal pointing at the light. */
+    vec3 toward = v3_scale(f.n, f.hx > 0 ? -1.0 : 1.0);
+    int cut = cut_occluders(c, light, &f, eye, toward, -1, &set, &scratch);
+    if (cut < 0)
+        return -1;
+    if (cut == 0)
+        return 0;
+    /* Back to the screen, where the pixel filter lives: areas there. */
+    vec3 sn = v3_normalize(v3_cross(v3_sub(corner[1], corner[0]), v3_sub(corner[3], corner[0])));
+    double so = v3_dot(sn, corner[0]);
+    vec3 su = v3_normalize(v3_sub(corner[1], corner[0])), sv = v3_cross(sn, su);
+    poly2 pix;
+    pix.n = 4;
+    for (int i = 0; i < 4; i++) {
+        vec3 d = v3_sub(corner[i], corner[0]);
+        pix.x[i] = v3_dot(d, su);
+        pix.y[i] = v3_dot(d, sv);
+    }
+    double pixel_area = fabs(poly2_area(&pix)), covered = 0;
+    for (int k = 0; k < set.count; k++) {
+        const poly2 *p = &set.piece[k];
+        if (p->n < 3)
+            continue;
+        poly2 s2;
+        s2.n = p->n;
+        for (int i = 0; i < p->n; i++) {
+            vec3 q = through_plane(eye, lift(&f, p->x[i], p->y[i]), sn, so);
+            vec3 d = v3_sub(q, corner[0]);
+            s2.x[i] = v3_dot(d, su);
+            s2.y[i] = v3_dot(d, sv);
+        }
+        covered += fabs(poly2_area(&s2));
+    }
+    return pixel_area > 0 ? fmin(1.0, covered / pixel_area) : 0;
+}

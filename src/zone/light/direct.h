@@ -1,0 +1,43 @@
+/* Direct light, exactly: the irradiance that one light part delivers to a
+ * point, with every occluder's shadow cut out of the light's polygon on the
+ * light's own plane (Lambert's formula over what is left).  Sphere lights
+ * are replaced by their silhouette disk (exact for a uniform sphere) and
+ * spheres, as occluders, by their silhouettes; both disks become polygons of
+ * `sides` vertices with the disk's area, the one approximation here. */
+#ifndef ZT_ZONE_DIRECT_H
+#define ZT_ZONE_DIRECT_H
+
+#include "render/render_scene.h"
+#include "scene/scene.h"
+#include "zone/light/occluders.h"
+
+typedef struct direct_ctx {
+    const zt_scene *scene;   /* double-precision geometry of the parts */
+    const rscene *rs;        /* mesh triangles, and rays */
+    const occluder_index *occ; /* what can cast shadows */
+    int sides;               /* polygon vertices for disks */
+    /* Where more occluders stand between a point and a light than clipping
+     * can take (a mesh), the light is cut into about this many triangles,
+     * each seen or hidden by a ray to its centre: exact as it grows. */
+    int fallback;
+} direct_ctx;
+
+/* Occluders clipped exactly at most; beyond, the fallback above. */
+#define DIRECT_MAX_OCCLUDERS 48
+
+/* Irradiance at x (unit normal n, on the side light arrives from) from
+ * light primitive `light` per unit emission, with exact visibility;
+ * receiver is the primitive x lies on (it casts no shadow on itself), -1
+ * for none. */
+double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
+                         int receiver);
+
+/* The fraction of a pixel (corners on the screen, in order around it) in
+ * which the eye sees light part `light` directly, with exact occlusion:
+ * the pixel's footprint on the light's plane, cut like a shadow, measured
+ * back on the screen.  -1 when too many occluders stand in the way (the
+ * caller measures it by rays). */
+double direct_pixel_coverage(const direct_ctx *c, int light, vec3 eye,
+                             const vec3 corner[4]);
+
+#endif

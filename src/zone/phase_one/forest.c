@@ -1,0 +1,423 @@
+/* The forest around the light: its frame (nodes, occluders, directions,
+ * quality), its zones, and what both phases ask of it. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/prim.h"
+#include "scene/mesh.h"
+#include "util/error.h"
+#include "util/vec3_convert.h"
+#include "geom/ray_offset.h"
+#include "zone/phase_one/glint.h"
+#include "zone/transfer/cut.h"
+#include "zone/zone.h"
+
+int zone_surface_of(const rscene *rs, int prim)
+{
+    if (prim < rs->part_count)
+        return prim;
+    const rs_mesh *mm = rs_mesh_of(rs, prim);
+    return rs->part_count + rs_mesh_object(mm, prim);
+}
+
+static void box_add(vec3 *lo, vec3 *hi, vec3 q)
+{
+    *lo = v3_min3(*lo, q);
+    *hi = v3_max3(*hi, q);
+}
+
+void zone_scene_bounds(const zt_scene *sc, const rscene *rs, vec3 *lo, vec3 *hi)
+{
+    *lo = v3(1e300, 1e300, 1e300);
+    *hi = v3(-1e300, -1e300, -1e300);
+    for (int i = 0; i < sc->part_count; i++) {
+        const part *p = &sc->parts[i];
+        if (p->shape == SHAPE_TRIANGLE) {
+            for (int k = 0; k < 3; k++)
+                box_add(lo, hi, p->p[k]);
+        } else if (p->shape == SHAPE_SPHERE) {
+            box_add(lo, hi, v3_sub(p->p[0], v3(p->radius, p->radius, p->radius)));
+            box_add(lo, hi, v3_add(p->p[0], v3(p->radius, p->radius, p->radius)));
+        } else if (p->shape == SHAPE_POINT) {
+            box_add(lo, hi, p->p[0]);
+        }
+    }
+    for (int k = 0; k < rs->mesh_count; k++) {
+        vec3 a, b;
+        mesh_bounds(rs->meshes[k].m, &a, &b);
+        if (a.x <= b.x) {
+            box_add(lo, hi, a);
+            box_add(lo, hi, b);
+        }
+    }
+    int finite = lo->x <= hi->x;
+    vec3 centre = finite ? v3_scale(v3_add(*lo, *hi), 0.5) : v3(0, 0, 0);
+    double reach = finite ? 2.0 * v3_length(v3_sub(*hi, *lo)) + 1e-9 : 1e6;
+    /* Rooms made of planes reach past the objects in them: add the corners
+     * where three planes meet, unless they lie far away. */
+    vec3 add_lo = *lo, add_hi = *hi;
+    for (int a = 0; a < sc->part_count; a++) {
+        const part *pa = &sc->parts[a];
+        for (int b = a + 1; b < sc->part_count && pa->shape == SHAPE_PLANE; b++) {
+            const part *pb = &sc->parts[b];
+            for (int k = b + 1; k < sc->part_count && pb->shape == SHAPE_PLANE; k++) {
+                const part *pc = &sc->parts[k];
+                if (pc->shape != SHAPE_PLANE)
+                    continue;
+                vec3 bc = v3_cross(pb->normal, pc->normal);
+                double det = v3_dot(pa->normal, bc);
+                if (fabs(det) < 1e-9)
+                    continue;
+                /* Cramer's rule for the point on all three planes. */
+                vec3 q = v3_scale(v3_add(v3_add(v3_scale(bc, pa->offset),
+                                                v3_scale(v3_cross(pc->normal, pa->normal), pb->offset)),
+                                         v3_scale(v3_cross(pa->normal, pb->normal), pc->offset)),
+                                  1.0 / det);
+                if (v3_length(v3_sub(q, centre)) <= reach)
+                    box_add(&add_lo, &add_hi, q);
+            }
+        }
+    }
+    *lo = add_lo;
+    *hi = add_hi;
+    if (lo->x > hi->x) {
+        /* Nothing finite and no corners: a unit box at the origin. */
+        *lo = v3(-1, -1, -1);
+        *hi = v3(1, 1, 1);
+    }
+}
+
+zone_quality zone_quality_for(const zt_scene *sc, const rscene *rs, int q)
+{
+    /* The scene's size (not the camera's: the forest must not depend on
+     * it) sets the node spacing; each quality step halves the area per
+     * node, doubles the gather directions and refines the transfer. */
+    vec3 lo, hi;
+    zone_scene_bounds(sc, rs, &lo, &hi);
+    double extent = v3_length(v3_sub(hi, lo));
+    double step = pow(sqrt(2.0), q);
+    zone_quality z;
+    memset(&z, 0, sizeof z);
+    z.gather = 64 << q;
+    z.texel_divisor = 20.0 * step;
+    z.texel = extent / z.texel_divisor;
+    z.max_texels = (int)(48.0 * step);
+    z.sides = 16 << (q / 2);
+    z.aa = q < 3 ? 1 : 2;
+    z.glint_cuts = 2 << (q / 2);
+    z.photons = 131072 << q;
+    z.theta = 0.5 / step;
+    /* The cut's error bound: at quality 2 (0.01) the Cornell box's level 2 is
+     * 2.4% at 128 x 128 for 0.6 s of Phase One (0.02: 3.2%, 0.45 s; 0.005:
+     * 2.1%, 0.9 s; a cut to every element: 1.9%, 8 s). */
+    z.eps = 0.02 / step;
+    z.fallback = 16 << q;
+    /* Coverage where an edge crosses a pixel: the grid's counting error
+     * along a straight edge (Cornell, 64x64, quality 4: 0.97% with
+     * 16 x 16, 0.67% with 32, 0.56% with 64). */
+    z.edge_grid = q < 3 ? 16 : q == 3 ? 32 : 64;
+    z.edge_shade = q < 4 ? 4 : q == 4 ? 8 : 16;
+    /* A regular grid counts a thin surface parallel to one of its
+     * diagonals or axes with the same bias in every row; a quasi-random
+     * set has no such direction (triangletest at quality 5). */
+    z.cover_quasi = q >= 5;
+    /* Signatures that look for edges inside smooth-looking pixels (thin
+     * lit slivers between shadows: triangletest's level 1 at quality 4
+     * went from 6.1% to 0.96% with 8 x 8). */
+    z.probe = q < 3 ? z.aa : q == 3 ? 4 : 8;
+    return z;
+}
+
+/* A fixed cosine-weighted direction set: a Hammersley point set through
+ * the disk-to-hemisphere map. */
+vec3 *zone_gather_directions(int n)
+{
+    vec3 *d = malloc((size_t)n * sizeof *d);
+    if (!d)
+        return NULL;
+    for (int i = 0; i < n; i++) {
+        uint32_t b = (uint32_t)i;
+        b = (b << 16) | (b >> 16);
+        b = ((b & 0x55555555u) << 1) | ((b & 0xAAAAAAAAu) >> 1);
+        b = ((b & 0x33333333u) << 2) | ((b & 0xCCCCCCCCu) >> 2);
+        b = ((b & 0x0F0F0F0Fu) << 4) | ((b & 0xF0F0F0F0u) >> 4);
+        b = ((b & 0x00FF00FFu) << 8) | ((b & 0xFF00FF00u) >> 8);
+        double u1 = (i + 0.5) / n, u2 = b * (1.0 / 4294967296.0);
+        double r = sqrt(u1), phi = 2 * 3.14159265358979 * u2;
+        d[i] = v3(r * cos(phi), r * sin(phi), sqrt(fmax(0.0, 1.0 - u1)));
+    }
+    return d;
+}
+
+zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
+{
+    const rscene *rs = &r->rs;
+    vec3 lo, hi;
+    zone_scene_bounds(r->scene, rs, &lo, &hi);
+    if (!surface_nodes_build(&f->sn, rs, r->scene, f->q.texel, f->q.max_texels, lo, hi))
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the surfaces' nodes");
+    if (!occluders_build(&f->occ, rs))
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the occluder index");
+    f->direct.scene = r->scene;
+    f->direct.rs = rs;
+    f->direct.occ = &f->occ;
+    f->direct.sides = f->q.sides;
+    f->direct.fallback = f->q.fallback;
+    f->dirs = zone_gather_directions(f->q.gather);
+    f->glint_spheres = malloc(((size_t)rs->part_count + 1) * sizeof(int));
+    if (!f->dirs || !f->glint_spheres)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    f->glint_count = 0;
+    for (int i = 0; i < rs->part_count; i++)
+        if (glint_sphere(rs, i))
+            f->glint_spheres[f->glint_count++] = i;
+    /* Light by way of mirrors, metal and glass is gathered; diffuse
+     * surfaces of every shape are the transfer's. */
+    f->need_gather = 0;
+    for (int i = 0; i < rs->object_count; i++) {
+        const rs_object *o = &rs->objects[i];
+        if (!o->is_light && o->weight[LOBE_DIFFUSE] < 1.0f &&
+            (o->weight[LOBE_METALLIC] > 0 || o->weight[LOBE_REFLECTING] > 0 ||
+             o->weight[LOBE_REFRACTIVE] > 0))
+            f->need_gather = 1;
+    }
+    f->sky = !f3_is_black(rs->sky);
+    if (rs->light_count > ZONE_LIGHTS_EXACT && !sender_tree_build_lights(&f->light_tree, rs))
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the light tree");
+    return ZT_OK;
+}
+
+void zone_forest_free(zone_forest *f)
+{
+    free(f->zones);
+    surface_nodes_free(&f->sn);
+    occluders_free(&f->occ);
+    free(f->e);
+    free(f->glint_spheres);
+    free(f->dirs);
+    sender_tree_free(&f->light_tree);
+    memset(f, 0, sizeof *f);
+}
+
+vec3 zone_map_read(const zone_forest *f, const rscene *rs, int level, int prim, int side, vec3 x)
+{
+    if (level < 0 || level >= f->map_levels)
+        return v3(0, 0, 0);
+    int32_t node[4];
+    float w[4];
+    int n = surface_nodes_weights(&f->sn, rs, prim, side, x, node, w);
+    vec3 e = v3(0, 0, 0);
+    for (int k = 0; k < n; k++) {
+        const float *v = zone_e(f, level, node[k]);
+        e = v3_add(e, v3_scale(v3(v[0], v[1], v[2]), w[k]));
+    }
+    return e;
+}
+
+typedef struct light_leaf_ctx {
+    zone_trace *t;
+    int receiver;
+} light_leaf_ctx;
+
+/* One light of the light tree, exactly (the side facing x only). */
+static void light_leaf(void *user, int i, vec3 x, vec3 n, double acc[3], cut_stats *st)
+{
+    (void)st;
+    const light_leaf_ctx *lc = user;
+    const zone_forest *f = lc->t->f;
+    const sender_elem *el = &f->light_tree.elems[i];
+    if (!el->any_way && (el->n[0] * (x.x - el->c[0]) + el->n[1] * (x.y - el->c[1]) +
+                         el->n[2] * (x.z - el->c[2])) <= 0)
+        return;
+    const float *em = &f->light_tree.elem_radiance[3 * (size_t)i];
+    double g = direct_irradiance(&f->direct, el->prim, x, n, lc->receiver);
+    for (int ch = 0; ch < 3; ch++)
+        acc[ch] += g * em[ch];
+}
+
+vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n)
+{
+    const rscene *rs = &t->r->rs;
+    if (t->f->light_tree.elem_count > 0) {
+        light_leaf_ctx lc = {t, receiver};
+        cut_params p = {t->f->q.eps, 0, 4096, light_leaf, &lc};
+        cut_stats st = {0, 0};
+        vec3 e = cut_gather(&t->f->light_tree, rs, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)),
+                            &p, &st);
+        t->rays += st.rays;
+        return e;
+    }
+    vec3 e = v3(0, 0, 0);
+    for (int i = 0; i < rs->light_count; i++) {
+        int prim = rs->lights[i].part;
+        rs_part tmp;
+        const rs_part *lp = rs_prim(rs, prim, &tmp);
+        vec3f em = rs->objects[lp->object].emission;
+        if (f3_is_black(em))
+            continue;
+        double g = direct_irradiance(&t->f->direct, prim, x, n, receiver);
+        e = v3_add(e, v3_scale(f3_to_v3(em), g));
+    }
+    return e;
+}
+
+/* ---- the zones ---- */
+
+static int push_zone(zone_forest *f, zone z)
+{
+    if (f->zone_count == f->zone_capacity) {
+        int cap = f->zone_capacity ? 2 * f->zone_capacity : 256;
+        zone *nz = realloc(f->zones, (size_t)cap * sizeof *nz);
+        if (!nz)
+            return 0;
+        f->zones = nz;
+        f->zone_capacity = cap;
+    }
+    f->zones[f->zone_count++] = z;
+    return 1;
+}
+
+static const int lobe_kind[LOBE_COUNT] = {ZONE_DIFFUSE, ZONE_METALLIC, ZONE_MIRROR,
+                                          ZONE_REFRACT};
+
+/* The representative object of a surface. */
+static const rs_object *surface_object(const rscene *rs, int s)
+{
+    return s < rs->part_count ? &rs->objects[rs->parts[s].object]
+                              : &rs->objects[s - rs->part_count];
+}
+
+/* Whether surface s has any primitive (mesh slots may be unused). */
+static void surfaces_present(const rscene *rs, unsigned char *present)
+{
+    for (int i = 0; i < rs->part_count; i++)
+        present[i] = 1;
+    for (int k = 0; k < rs->mesh_count; k++) {
+        const rs_mesh *mm = &rs->meshes[k];
+        for (int t = 0; t < mm->m->triangle_count; t++)
+            present[rs->part_count + rs_mesh_object(mm, mm->prim_base + t)] = 1;
+    }
+}
+
+/* Flux arriving at each surface at each map level: the elements' mean
+ * irradiance times their areas. */
+static int incident_flux(const zone_forest *f, const rscene *rs, double *flux)
+{
+    int ns = zone_surface_count(rs);
+    for (int prim = 0; prim < f->sn.prim_count; prim++) {
+        int ne = surface_element_count(&f->sn, prim);
+        if (ne == 0)
+            continue;
+        int s = zone_surface_of(rs, prim);
+        for (int side = 0; side < f->sn.prim[prim].sides; side++)
+            for (int e = 0; e < ne; e++) {
+                vec3 q[4];
+                int32_t node[4];
+                int corners = surface_element(&f->sn, rs, prim, side, e, q, node);
+                double area = 0;
+                for (int k = 1; k + 1 < corners; k++)
+                    area += 0.5 * v3_length(v3_cross(v3_sub(q[k], q[0]), v3_sub(q[k + 1], q[0])));
+                for (int level = 0; level < f->map_levels; level++) {
+                    double sum = 0;
+                    int live = 0;
+                    for (int k = 0; k < corners; k++)
+                        if (node[k] >= 0 && f->sn.live[node[k]]) {
+                            const float *v = zone_e(f, level, node[k]);
+                            sum += 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
+                            live++;
+                        }
+                    if (live)
+                        flux[(size_t)level * ns + s] += sum / live * area;
+                }
+            }
+    }
+    return 1;
+}
+
+zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
+{
+    const rscene *rs = &r->rs;
+    int depth = r->options.level >= 0 ? r->options.level : r->options.depth;
+    double cutoff = r->options.cutoff;
+    int ns = zone_surface_count(rs);
+    unsigned char *present = calloc((size_t)ns + 1, 1);
+    double *flux = calloc((size_t)(f->map_levels + 1) * ns + 1, sizeof *flux);
+    double *level_power = calloc((size_t)depth + 2, sizeof *level_power);
+    if (!present || !flux || !level_power) {
+        free(present);
+        free(flux);
+        free(level_power);
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the zones");
+    }
+    surfaces_present(rs, present);
+    incident_flux(f, rs, flux);
+    /* The sky is no zone, but what it sends is light of level 0: as much as
+     * all the surfaces could take in. */
+    if (!f3_is_black(rs->sky)) {
+        double area = 0;
+        for (int i = 0; i < rs->prim_count; i++) {
+            rs_part tmp;
+            const rs_part *p = rs_prim(rs, i, &tmp);
+            area += p->shape == SHAPE_PLANE ? 0 : p->area;
+        }
+        level_power[0] += f3_luminance(rs->sky) * 3.14159265358979 * (area > 0 ? area : 1.0);
+        if (rs->planes[0].count + rs->planes[1].count > 0)
+            level_power[0] = INFINITY; /* an infinite plane under the sky */
+    }
+    int ok = 1;
+    /* Roots: every light primitive that emits. */
+    for (int i = 0; i < rs->light_count && ok; i++) {
+        rs_part tmp;
+        const rs_part *lp = rs_prim(rs, rs->lights[i].part, &tmp);
+        const rs_object *o = &rs->objects[lp->object];
+        double area = lp->shape == SHAPE_POINT ? 4.0 : lp->area * (lp->culled ? 1.0 : 2.0);
+        zone z = {rs->lights[i].part, ZONE_EMIT, 0,
+                  (float)(f3_luminance(o->emission) * 3.14159265358979 * area)};
+        if (!(z.power > 0))
+            continue;
+        if (z.power <= cutoff) {
+            f->pruned++;
+            continue;
+        }
+        level_power[0] += z.power;
+        ok = push_zone(f, z);
+    }
+    /* One zone per surface, lobe and level above. */
+    for (int level = 1; level <= depth && ok; level++) {
+        for (int s = 0; s < ns && ok; s++) {
+            if (!present[s])
+                continue;
+            const rs_object *o = surface_object(rs, s);
+            if (o->is_light)
+                continue;
+            for (int k = 0; k < LOBE_COUNT && ok; k++) {
+                if (o->weight[k] <= 0.0f)
+                    continue;
+                double arriving = level - 1 < f->map_levels
+                                      ? flux[(size_t)(level - 1) * ns + s]
+                                      : level_power[level - 1];
+                /* A specular lobe passes on whatever arrives: bounded by
+                 * all the light of the level below. */
+                if (k != LOBE_DIFFUSE)
+                    arriving = level_power[level - 1];
+                zone z = {s, (uint8_t)lobe_kind[k], (uint8_t)level,
+                          (float)(arriving * o->weight[k] * f3_max(o->color))};
+                if (!(z.power > 0))
+                    continue;
+                if (z.power <= cutoff) {
+                    f->pruned++;
+                    continue;
+                }
+                level_power[level] += z.power;
+                ok = push_zone(f, z);
+            }
+        }
+    }
+    free(present);
+    free(flux);
+    free(level_power);
+    if (!ok)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the zones");
+    return ZT_OK;
+}

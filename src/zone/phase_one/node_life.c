@@ -1,0 +1,247 @@
+/* Which nodes light can reach (node_life.h). */
+#include "zone/phase_one/node_life.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "render/prim.h"
+#include "zone/light/zprim.h"
+
+#define PROBES 8
+
+/* Whether plane part q hides the open half-space behind it from every
+ * light: opaque, a thing, the sky black, every light in front of it. */
+static int is_wall(const zt_scene *sc, const rscene *rs, int q)
+{
+    const part *pq = &sc->parts[q];
+    const object *oq = &sc->objects[pq->object];
+    if (pq->shape != SHAPE_PLANE || oq->is_light || oq->mat.weight[LOBE_REFRACTIVE] > 0 ||
+        !f3_is_black(rs->sky))
+        return 0;
+    double eps = 1e-9 * (1.0 + fabs(pq->offset));
+    for (int l = 0; l < rs->light_count; l++) {
+        zprim lp;
+        zprim_get(sc, rs, rs->lights[l].part, &lp);
+        switch (lp.shape) {
+        case SHAPE_TRIANGLE:
+            for (int k = 0; k < 3; k++)
+                if (v3_dot(pq->normal, lp.p[k]) - pq->offset < -eps)
+                    return 0;
+            break;
+        case SHAPE_SPHERE:
+            if (v3_dot(pq->normal, lp.p[0]) - pq->offset < lp.radius - eps)
+                return 0;
+            break;
+        case SHAPE_POINT:
+            if (v3_dot(pq->normal, lp.p[0]) - pq->offset < -eps)
+                return 0;
+            break;
+        default:
+            return 0;
+        }
+    }
+    /* Point lights switched off are not in rs->lights but must not be
+     * behind it either (the forest is the same with lights off). */
+    for (int i = 0; i < rs->point_light_count; i++) {
+        const part *lp = &sc->parts[rs->point_lights[i]];
+        if (v3_dot(pq->normal, lp->p[0]) - pq->offset < -eps)
+            return 0;
+    }
+    return 1;
+}
+
+/* Ray against one primitive in double precision, culling ignored:
+ * distance in (tmin, tmax) or -1; *back when it meets the back side. */
+static double hit_prim(const zprim *p, vec3 o, vec3 d, double tmax, int *back)
+{
+    switch (p->shape) {
+    case SHAPE_TRIANGLE: {
+        vec3 e1 = v3_sub(p->p[1], p->p[0]), e2 = v3_sub(p->p[2], p->p[0]);
+        vec3 pv = v3_cross(d, e2);
+        double det = v3_dot(e1, pv);
+        if (det == 0)
+            return -1;
+        double inv = 1.0 / det;
+        vec3 tv = v3_sub(o, p->p[0]);
+        double u = v3_dot(tv, pv) * inv;
+        if (u < 0 || u > 1)
+            return -1;
+        vec3 qv = v3_cross(tv, e1);
+        double v = v3_dot(d, qv) * inv;
+        if (v < 0 || u + v > 1)
+            return -1;
+        double t = v3_dot(e2, qv) * inv;
+        if (!(t > 0 && t < tmax))
+            return -1;
+        *back = det < 0; /* det = -d . (e1 x e2) */
+        return t;
+    }
+    case SHAPE_SPHERE: {
+        vec3 f = v3_sub(o, p->p[0]);
+        double b = v3_dot(f, d), c = v3_dot(f, f) - p->radius * p->radius;
+        double disc = b * b - c;
+        if (disc < 0)
+            return -1;
+        double s = sqrt(disc), t0 = -b - s, t1 = -b + s;
+        if (t0 > 0 && t0 < tmax) {
+            *back = 0;
+            return t0;
+        }
+        if (t1 > 0 && t1 < tmax) {
+            *back = 1;
+            return t1;
+        }
+        return -1;
+    }
+    case SHAPE_PLANE: {
+        double dn = v3_dot(d, p->normal);
+        if (dn == 0)
+            return -1;
+        double t = (p->offset - v3_dot(o, p->normal)) / dn;
+        if (!(t > 0 && t < tmax))
+            return -1;
+        *back = dn > 0;
+        return t;
+    }
+    default:
+        return -1;
+    }
+}
+
+static int slab(const occ_node *b, vec3 o, vec3 inv, double tmax)
+{
+    double t0 = 0, t1 = tmax;
+    double oo[3] = {o.x, o.y, o.z}, ii[3] = {inv.x, inv.y, inv.z};
+    for (int a = 0; a < 3; a++) {
+        double u = (b->lo[a] - oo[a]) * ii[a], v = (b->hi[a] - oo[a]) * ii[a];
+        if (u > v) {
+            double w = u;
+            u = v;
+            v = w;
+        }
+        t0 = fmax(t0, u);
+        t1 = fmin(t1, v * 1.0000001);
+        if (t0 > t1)
+            return 0;
+    }
+    return 1;
+}
+
+int node_life_first_hit(const occluder_index *occ, const zt_scene *scene, const rscene *rs,
+                        vec3 o, vec3 d, int *back)
+{
+    double best = INFINITY;
+    int found = -1;
+    for (int i = 0; i < rs->part_count; i++) {
+        if (scene->parts[i].shape != SHAPE_PLANE)
+            continue;
+        zprim p;
+        zprim_get(scene, rs, i, &p);
+        int b;
+        double t = hit_prim(&p, o, d, best, &b);
+        if (t > 0) {
+            best = t;
+            found = i;
+            *back = b;
+        }
+    }
+    if (occ->prim_count == 0)
+        return found;
+    vec3 inv = v3(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+    int32_t stack[128];
+    int sp = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const occ_node *node = &occ->nodes[stack[--sp]];
+        if (!slab(node, o, inv, best))
+            continue;
+        if (node->count > 0) {
+            int first = -1 - node->left;
+            for (int k = 0; k < node->count; k++) {
+                int prim = occ->prims[first + k];
+                zprim p;
+                zprim_get(scene, rs, prim, &p);
+                int b;
+                double t = hit_prim(&p, o, d, best, &b);
+                /* Ties to the lower number, for a fixed answer. */
+                if (t > 0 && (t < best || (t == best && prim < found))) {
+                    best = t;
+                    found = prim;
+                    *back = b;
+                }
+            }
+        } else if (sp + 2 <= 128) {
+            stack[sp++] = node->left + 1;
+            stack[sp++] = node->left;
+        }
+    }
+    return found;
+}
+
+/* A fixed set of directions around the normal (a golden-angle spiral over
+ * the hemisphere, cosine-distributed). */
+static vec3 probe_dir(vec3 n, int k)
+{
+    vec3 a = fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0);
+    vec3 t = v3_normalize(v3_cross(a, n)), b = v3_cross(n, t);
+    double u = (k + 0.5) / PROBES, r = sqrt(u), phi = k * 2.39996322972865332;
+    return v3_normalize(v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))),
+                               v3_scale(n, sqrt(1.0 - u))));
+}
+
+uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_scene *scene,
+                        const rscene *rs, int threads)
+{
+    int *walls = malloc(((size_t)rs->part_count + 1) * sizeof *walls);
+    int nw = 0;
+    if (walls)
+        for (int q = 0; q < rs->part_count; q++)
+            if (is_wall(scene, rs, q))
+                walls[nw++] = q;
+    double h = sn->h, seam = 1e-4 * h;
+    uint64_t rays = 0;
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads) reduction(+ : rays)
+    for (int k = 0; k < sn->node_count; k++) {
+        if (!sn->live[k])
+            continue;
+        vec3 x = v3(sn->pos[3 * k], sn->pos[3 * k + 1], sn->pos[3 * k + 2]);
+        vec3 n = v3(sn->nrm[3 * k], sn->nrm[3 * k + 1], sn->nrm[3 * k + 2]);
+        int prim = sn->prim_of[k];
+        rs_part tmp;
+        int fore = !rs_prim(rs, prim, &tmp)->background;
+        int dead = 0;
+        for (int w = 0; w < nw && !dead; w++) {
+            const part *pw = &scene->parts[walls[w]];
+            if (walls[w] == prim || (fore && scene->objects[pw->object].background))
+                continue;
+            double s = v3_dot(pw->normal, x) - pw->offset;
+            if (s < -seam)
+                dead = 1;
+            else if (s < seam)
+                /* On the seam: lit a quarter cell inside the room, where
+                 * the light no longer sees the wall edge-on. */
+                x = v3_add(x, v3_scale(pw->normal, seam - s + 0.25 * h));
+        }
+        if (!dead) {
+            /* Inside a closed object most directions meet a back face. */
+            vec3 o = v3_add(x, v3_scale(n, 1e-4 * h));
+            int inside = 0;
+            for (int p = 0; p < PROBES; p++) {
+                int back = 0;
+                int hit = node_life_first_hit(occ, scene, rs, o, probe_dir(n, p), &back);
+                rays++;
+                /* Only a culled surface's back is a wall nothing passes:
+                 * the back of a two-sided one is a surface like any. */
+                rs_part hp;
+                inside += hit >= 0 && back && rs_prim(rs, hit, &hp)->culled;
+            }
+            dead = 2 * inside >= PROBES;
+        }
+        sn->live[k] = (uint8_t)!dead;
+        sn->pos[3 * k] = (float)x.x;
+        sn->pos[3 * k + 1] = (float)x.y;
+        sn->pos[3 * k + 2] = (float)x.z;
+    }
+    free(walls);
+    return rays;
+}

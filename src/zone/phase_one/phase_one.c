@@ -1,0 +1,223 @@
+/* Phase One: the irradiance at every node, level by level, then the zones.
+ *
+ *   E_0  the lights' direct light, exact (direct.c), plus the sky's,
+ *        gathered over fixed directions;
+ *   E_k  (k >= 1) the light of level k arriving: from diffuse surfaces by
+ *        the transfer (transfer.h) of E_{k-1} through the sender tree; by
+ *        way of mirrors, metal and glass by gathering, and from the lights
+ *        straight through them by caustic photons (caustic.c) and images
+ *        in spheres (glint.c).
+ *
+ * Pixel level L reads E_{L-1} (level 1 is exact per pixel), so depth D
+ * needs E_0 .. E_{D-1}. */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "util/error.h"
+#include "util/vec3_convert.h"
+#include "zone/phase_one/caustic.h"
+#include "zone/phase_one/glint.h"
+#include "zone/phase_one/node_life.h"
+#include "zone/transfer/sender_tree.h"
+#include "zone/transfer/transfer.h"
+#include "zone/zone.h"
+
+static void frame(vec3 n, vec3 *t, vec3 *b)
+{
+    vec3 a = fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0);
+    *t = v3_normalize(v3_cross(a, n));
+    *b = v3_cross(n, *t);
+}
+
+vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
+{
+    const zone_forest *f = t->f;
+    const rscene *rs = &t->r->rs;
+    vec3 tt, bb;
+    frame(n, &tt, &bb);
+    vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
+    int open = 0;
+    for (int k = 0; k < f->q.gather; k++) {
+        const vec3 *dk = &f->dirs[k];
+        vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
+        hit h = accel_intersect(rs, o, v3_to_f3(d));
+        t->rays++;
+        open += h.part < 0;
+    }
+    return v3_scale(v3(rs->sky.x, rs->sky.y, rs->sky.z), 3.14159265358979 * open / f->q.gather);
+}
+
+/* Light arriving at level `level` by way of specular surfaces: gathered
+ * over the fixed directions, diffuse surfaces left to the transfer. */
+static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
+{
+    const zone_forest *f = t->f;
+    vec3 tt, bb;
+    frame(n, &tt, &bb);
+    vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
+    vec3 sum = v3(0, 0, 0);
+    for (int k = 0; k < f->q.gather; k++) {
+        const vec3 *dk = &f->dirs[k];
+        vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
+        sum = v3_add(sum, zone_radiance(t, o, v3_to_f3(v3_normalize(d)), level, level,
+                                        ZR_SKIP_DIFFUSE | ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0));
+    }
+    return v3_scale(sum, 3.14159265358979 / f->q.gather);
+}
+
+static vec3 node_point(const surface_nodes *sn, int32_t k, vec3 *n)
+{
+    *n = v3(sn->nrm[3 * k], sn->nrm[3 * k + 1], sn->nrm[3 * k + 2]);
+    return v3(sn->pos[3 * k], sn->pos[3 * k + 1], sn->pos[3 * k + 2]);
+}
+
+/* Level `level`'s irradiance at live node k (without the caustics). */
+static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const transfer_ctx *tc,
+                       int32_t k, uint64_t *rays, uint64_t *links)
+{
+    const surface_nodes *sn = &f->sn;
+    zone_trace t = {f, r, 0};
+    vec3 n, x = node_point(sn, k, &n);
+    int prim = sn->prim_of[k];
+    vec3 e;
+    if (level == 0) {
+        e = zone_lights_at(&t, prim, x, n);
+        if (f->sky)
+            e = v3_add(e, zone_sky_irradiance(&t, x, n));
+    } else {
+        /* Far out on a plane a node stands for a wide cell that matters
+         * little: a coarser cut (the square root of its growth, as the
+         * texels had). */
+        transfer_ctx tk = *tc;
+        tk.eps = tc->eps * sqrt(sn->growth[k]);
+        transfer_stats ts = {0, 0};
+        e = transfer_irradiance(&tk, x, n, prim, &ts);
+        t.rays += ts.rays;
+        *links += ts.clusters;
+        if (level == 1 && f->glint_count)
+            e = v3_add(e, glint_irradiance(&t, f->glint_spheres, f->glint_count, x, n,
+                                           f->q.glint_cuts));
+        if (f->need_gather)
+            e = v3_add(e, specular_gather(&t, x, n, level));
+    }
+    *rays += t.rays;
+    return e;
+}
+
+/* Whether the light along a grid line (four nodes of earlier rounds,
+ * live) is straight enough for the node between the inner two to be read
+ * linearly from them: the parabola through either three differs there
+ * from the line by at most SMOOTH of the values.  *w: the far one's
+ * weight. */
+#define SMOOTH 0.01
+static int straight(const surface_nodes *sn, const float *v, const int32_t line[4],
+                    const double pos[5], double *w)
+{
+    for (int s = 0; s < 4; s++)
+        if (!sn->live[line[s]])
+            return 0;
+    const double *t = pos, x = pos[4];
+    *w = (x - t[1]) / (t[2] - t[1]);
+    for (int ch = 0; ch < 3; ch++) {
+        double a = v[3 * (size_t)line[0] + ch], b = v[3 * (size_t)line[1] + ch];
+        double c = v[3 * (size_t)line[2] + ch], d = v[3 * (size_t)line[3] + ch];
+        double top = dmax(dmax(a, b), dmax(c, d));
+        /* The parabola's excess over the chord b-c at x: its second
+         * divided difference times (x - t1)(x - t2). */
+        double k = (x - t[1]) * (x - t[2]);
+        double dd1 = ((c - b) / (t[2] - t[1]) - (b - a) / (t[1] - t[0])) / (t[2] - t[0]);
+        double dd2 = ((d - c) / (t[3] - t[2]) - (c - b) / (t[2] - t[1])) / (t[3] - t[1]);
+        if (fabs(dd1 * k) > SMOOTH * top || fabs(dd2 * k) > SMOOTH * top)
+            return 0;
+    }
+    return 1;
+}
+
+/* E_level at every live node, added to what is there (caustics).  Coarse
+ * nodes first; a finer node midway between coarser ones on a straight
+ * stretch is their mean (surface_node_line), else it is computed too.  The
+ * rounds depend on nothing but the nodes, so the values are the same on
+ * any thread count. */
+static void build_level(zone_forest *f, const zt_renderer *r, int level,
+                        const sender_tree *tree)
+{
+    const rscene *rs = &r->rs;
+    const surface_nodes *sn = &f->sn;
+    transfer_ctx tc = {tree, sn, rs, level > 0 ? zone_e(f, level - 1, 0) : NULL,
+                       f->q.eps, f->q.theta, 0, 4096};
+    /* Receivers far darker than the scene's average need no fine cut. */
+    if (level > 0 && tree->total_area > 0)
+        tc.floor = 0.02 * 3.14159265358979 * tree->total_power / tree->total_area;
+    float *v = calloc(3 * (size_t)sn->node_count + 3, sizeof(float));
+    if (!v)
+        return;
+    uint64_t rays = 0, links = 0;
+    int threads = render_thread_count(r->options.threads);
+    for (int pass = 0; pass < NODE_ROUNDS; pass++) {
+#pragma omp parallel for schedule(dynamic, 64) num_threads(threads) reduction(+ : rays, links)
+        for (int k = 0; k < sn->node_count; k++) {
+            if (!sn->live[k])
+                continue;
+            int32_t line[4];
+            double pos[5], w = 0.5;
+            int fine = surface_node_line(sn, rs, k, line, pos);
+            if (fine != pass)
+                continue;
+            vec3 e;
+            if (fine && straight(sn, v, line, pos, &w)) {
+                const float *b = &v[3 * (size_t)line[1]], *c = &v[3 * (size_t)line[2]];
+                e = v3((1 - w) * b[0] + w * c[0], (1 - w) * b[1] + w * c[1],
+                       (1 - w) * b[2] + w * c[2]);
+            } else {
+                e = node_value(f, r, level, &tc, k, &rays, &links);
+            }
+            v[3 * (size_t)k] = (float)e.x;
+            v[3 * (size_t)k + 1] = (float)e.y;
+            v[3 * (size_t)k + 2] = (float)e.z;
+        }
+    }
+    for (int k = 0; k < sn->node_count; k++) {
+        float *px = zone_e(f, level, k);
+        for (int ch = 0; ch < 3; ch++)
+            px[ch] += v[3 * (size_t)k + ch];
+    }
+    free(v);
+    f->rays += rays;
+    f->links += links;
+}
+
+zt_status zone_phase_one(zone_forest *f, const zt_renderer *r, zt_error *err)
+{
+    zt_status st = zone_forest_frame(f, r, err);
+    if (st != ZT_OK)
+        return st;
+    int depth = r->options.level >= 0 ? r->options.level : r->options.depth;
+    f->map_levels = depth >= 2 ? depth : 0;
+    if (f->map_levels > 0) {
+        f->rays += node_life_mark(&f->sn, &f->occ, r->scene, &r->rs,
+                                  render_thread_count(r->options.threads));
+        size_t n = (size_t)f->map_levels * (size_t)f->sn.node_count * 3;
+        f->e = calloc(n + 3, sizeof(float));
+        if (!f->e)
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory for %zu node values", n);
+        /* Light through mirrors and glass from the lights, into the levels
+         * it arrives at; the rest is added level by level. */
+        st = caustic_build(f, r, err);
+        if (st != ZT_OK)
+            return st;
+        sender_tree tree;
+        if (!sender_tree_build(&tree, &f->sn, &r->rs))
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the sender tree");
+        for (int level = 0; level < f->map_levels; level++) {
+            if (level > 0)
+                sender_tree_fill(&tree, &f->sn, &r->rs, zone_e(f, level - 1, 0));
+            build_level(f, r, level, &tree);
+        }
+        sender_tree_free(&tree);
+    }
+    return zone_forest_zones(f, r, err);
+}

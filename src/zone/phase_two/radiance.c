@@ -1,0 +1,123 @@
+/* Radiance by level along a ray, from the forest:
+ *   level 0      lights (and sky) seen directly;
+ *   level 1      diffuse: rho/pi * exact direct irradiance (camera paths) or
+ *                the level-0 map (gathers);
+ *   level l >= 2 diffuse: rho/pi * the level l-1 irradiance map;
+ *   specular lobes (mirror, metal, glass) pass the levels below theirs on
+ *   along the reflected and refracted rays, deterministically: the glass
+ *   lobe follows both the reflected and the transmitted ray. */
+#include "zone/zone.h"
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "geom/shapes.h"
+#include "light/light_sample.h"
+#include "material/bsdf.h"
+#include "render/prim.h"
+#include "util/vec3_convert.h"
+#include "zone/phase_two/media.h"
+#include "zone/phase_one/caustic.h"
+#include "zone/phase_one/glint.h"
+
+
+
+vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
+                   int flags, const int *media, int media_count)
+{
+    int exact_direct = flags & ZR_EXACT_DIRECT;
+    if (hi < 0 || lo > hi)
+        return v3(0, 0, 0);
+    const rscene *rs = &t->r->rs;
+    hit h = accel_intersect(rs, o, d);
+    t->rays++;
+    if (h.part < 0)
+        return lo <= 0 ? f3_to_v3(rs->sky) : v3(0, 0, 0);
+    rs_part tmp;
+    const rs_part *p = rs_prim(rs, h.part, &tmp);
+    vec3f xf = f3_madd(o, d, h.t);
+    /* Lights that send caustic photons (caustic.h) are theirs to count
+     * after a caustic target. */
+    int photons = (flags & ZR_CAUSTIC_LIGHT) &&
+                  (p->shape == SHAPE_TRIANGLE || p->shape == SHAPE_SPHERE);
+    /* Light parts seen by the camera are measured by coverage; mesh lights
+     * are shaded on the samples. */
+    if (p->is_light)
+        return lo <= 0 && !((flags & ZR_NO_EMISSION) && h.part < rs->part_count) && !photons
+                   ? f3_to_v3(light_emitted(rs, p, xf, d))
+                   : v3(0, 0, 0);
+    if (hi < 1)
+        return v3(0, 0, 0);
+
+    const rs_object *m = &rs->objects[p->object];
+    vec3f ngf = shape_normal(p, xf);
+    int back = f3_dot(ngf, d) > 0.0f;
+    vec3f nf = back ? f3_neg(ngf) : ngf;
+    /* Meshes: shading normal and texture; the geometric normal decides
+     * the side. */
+    rs_shade sh = {nf, m->color};
+    if (rs_needs_shade(rs, h.part, m))
+        rs_shade_at(rs, h.part, p, m, xf, nf, &sh);
+    vec3 x = f3_to_v3(xf), n = f3_to_v3(sh.ns), color = f3_to_v3(sh.albedo);
+    vec3 out = v3(0, 0, 0);
+
+    if (m->weight[LOBE_DIFFUSE] > 0.0f && !(flags & ZR_SKIP_DIFFUSE)) {
+        vec3 e = v3(0, 0, 0);
+        for (int l = lo > 1 ? lo : 1; l <= hi; l++) {
+            if (l == 1 && exact_direct) {
+                /* Exact direct light from the lights, and the sky's. */
+                e = v3_add(e, zone_lights_at(t, h.part, x, n));
+                if (t->f->sky)
+                    e = v3_add(e, zone_sky_irradiance(t, x, n));
+            } else {
+                e = v3_add(e, zone_map_read(t->f, rs, l - 1, h.part, back, x));
+            }
+        }
+        out = v3_add(out, v3_scale(v3_mul(color, e), m->weight[LOBE_DIFFUSE] / 3.14159265358979));
+    }
+
+    float wm = m->weight[LOBE_METALLIC], wr = m->weight[LOBE_REFLECTING];
+    float wt = m->weight[LOBE_REFRACTIVE];
+    if (hi >= 1 && (wm > 0.0f || wr > 0.0f || wt > 0.0f)) {
+        vec3f ng_facing = nf;
+        nf = sh.ns;
+        vec3f wo = f3_neg(d);
+        float cos_o = f3_dot(nf, wo);
+        vec3f refl = f3_normalize(f3_sub(d, f3_scale(nf, 2.0f * f3_dot(d, nf))));
+        vec3f out_o = ray_offset(xf, ng_facing);
+        double k_refl = wr;
+        if (wm > 0.0f)
+            k_refl += wm * bsdf_schlick(cos_o, m->ior);
+        double k_tran = 0;
+        int entering = media_count == 0 || media[media_count - 1] != p->object;
+        float eta_i = media_count ? rs->objects[media[media_count - 1]].ior : 1.0f;
+        float eta_t = entering ? m->ior
+                               : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
+        if (wt > 0.0f) {
+            float fr = bsdf_fresnel_dielectric(cos_o, eta_i, eta_t);
+            k_refl += wt * fr;
+            k_tran = wt * (1.0 - fr);
+        }
+        /* Under ZR_NO_CAUSTIC every specular ray passes it on, and marks
+         * the rays that leave a caustic target. */
+        int cflags = 0;
+        if (flags & ZR_NO_CAUSTIC)
+            cflags = ZR_NO_CAUSTIC | (caustic_target(rs, h.part) ? ZR_CAUSTIC_LIGHT : 0);
+        if (k_refl > 0) {
+            int rflags = exact_direct | cflags;
+            if ((flags & ZR_NO_GLINT) && !back && media_count == 0 && glint_sphere(rs, h.part))
+                rflags |= ZR_NO_EMISSION;
+            vec3 l = zone_radiance(t, out_o, refl, lo - 1, hi - 1, rflags, media, media_count);
+            out = v3_add(out, v3_scale(v3_mul(color, l), k_refl));
+        }
+        if (k_tran > 0) {
+            float eta = eta_i / eta_t;
+            vec3f tr = media_refract(d, nf, cos_o, eta);
+            int next[MEDIA_MAX];
+            int nc = media_cross(media, media_count, p->object, entering, next);
+            vec3 l = zone_radiance(t, ray_offset(xf, f3_neg(ng_facing)), tr, lo - 1, hi - 1,
+                                   exact_direct | cflags, next, nc);
+            out = v3_add(out, v3_scale(v3_mul(color, l), k_tran * eta * eta));
+        }
+    }
+    return out;
+}

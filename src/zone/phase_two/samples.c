@@ -1,0 +1,462 @@
+/* Phase Two, step one: the sample list of every pixel.
+ *
+ * A pixel whose corner and sub-pixel signatures agree sees one smooth
+ * surface: its g x g samples are shaded, each with weight 1/g^2.  Where they
+ * differ, an edge crosses the pixel: a 16 x 16 grid (32 x 32 at quality 3,
+ * 64 x 64 from 4) measures the coverage of each surface (group of equal
+ * signatures), and each group is shaded on the samples of a sparse 4 x 4
+ * (8 x 8 at quality 4, 16 x 16 from 5) subset that fall in it (or on the
+ * point nearest its centroid when it misses the subset), weighted by its
+ * coverage; from quality 5 the grid's points are quasi-random.  Where
+ * a light is seen in a mirror or through glass, where phase_two_marks.c
+ * expects a light's small image in a sphere, or where a sample falls in a
+ * refined texel (refine.c), the grid is 64 x 64.  Light
+ * parts seen at a corner or a sample, or with a vertex in the pixel, are
+ * listed for the exact level-0 coverage. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "geom/shapes.h"
+#include "render/prim.h"
+#include "util/vec3_convert.h"
+#include "zone/phase_two/media.h"
+#include "zone/phase_two/phase_two.h"
+
+#define FINE_GRID 64   /* the grid where a light is seen by way of a mirror */
+#define FINE_SHADE 16  /* and its shaded samples per side */
+#define SEEN_MAX 8     /* light parts listed per pixel */
+#define CURVED_GRID 2  /* sub-pixel grid of smooth pixels that see a sphere */
+/* Specular steps a signature follows.  Fixed, not the render's depth: the
+ * images of levels 0..D must use the same samples as the depth-D image,
+ * or they would not add up to it. */
+#define SIGNATURE_STEPS 16
+
+/* Which point lights light x (normal n, facing the viewer) as bits: a
+ * point light's shadow is hard, and a pixel its edge crosses must be
+ * measured like any other edge, not shaded from one sample. */
+static uint32_t point_light_bits(const rscene *rs, vec3f x, vec3f n, uint64_t *rays)
+{
+    uint32_t bits = 0;
+    vec3f xo = ray_offset(x, n);
+    for (int k = 0; k < rs->point_light_count && k < 32; k++) {
+        const rs_part *lp = &rs->parts[rs->point_lights[k]];
+        vec3f to = f3_sub(lp->p0, xo);
+        float dist = f3_length(to);
+        if (f3_dot(to, n) > 0.0f && dist > 0.0f) {
+            (*rays)++;
+            if (!accel_occluded(rs, xo, f3_scale(to, 1.0f / dist), dist, lp->background))
+                bits |= 1u << k;
+        }
+    }
+    return bits + 1;
+}
+
+/* What a camera ray sees, as a number: the parts along its specular chain
+ * (the transmitted branch through glass), and which point lights light its
+ * diffuse hits.  Sub-pixel samples with the same
+ * signature see one smooth surface; differing ones mark an edge.  *first is
+ * the ray's first hit; *curved (unless NULL) is set when the chain meets a
+ * sphere, *glint (unless NULL) when it ends on a light after a specular step. */
+static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays,
+                              hit *first, int *curved, int *glint)
+{
+    uint32_t sig = 0x811c9dc5u;
+    int inside = -1; /* the refractive object the chain is in */
+    for (int k = 0; k <= SIGNATURE_STEPS; k++) {
+        hit h = accel_intersect(rs, o, d);
+        (*rays)++;
+        if (k == 0)
+            *first = h;
+        /* A mesh's triangles of one material are one surface: the
+         * edges between them are not edges of the image. */
+        sig = (sig ^ (uint32_t)(h.part < 0 ? 0 : zone_surface_of(rs, h.part) + 1)) * 16777619u;
+        if (h.part < 0)
+            break;
+        rs_part tmp;
+        const rs_part *p = rs_prim(rs, h.part, &tmp);
+        const rs_object *m = &rs->objects[p->object];
+        if (curved && p->shape == SHAPE_SPHERE)
+            *curved = 1;
+        if (p->is_light && k > 0 && glint)
+            *glint = 1;
+        if (p->is_light)
+            break;
+        vec3f x = f3_madd(o, d, h.t);
+        vec3f ng = shape_normal(p, x);
+        vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
+        if (m->weight[LOBE_DIFFUSE] > 0.0f && rs->point_light_count)
+            sig = (sig ^ point_light_bits(rs, x, n, rays)) * 16777619u;
+        if (m->weight[LOBE_DIFFUSE] >= 1.0f)
+            break;
+        float cos_o = -f3_dot(d, n);
+        /* Follow the refracted branch as it bends: a light seen through
+         * glass has its edge where the bent ray leaves it, and the coverage
+         * grid must find it there.  Entering or leaving is decided by
+         * object identity, as in the tracers, so hollow shells work. */
+        int leaving = p->object == inside;
+        float eta = leaving ? m->ior : 1.0f / m->ior;
+        float sin2_t = eta * eta * (1.0f - cos_o * cos_o);
+        if (m->weight[LOBE_REFRACTIVE] > 0.0f && sin2_t < 1.0f) {
+            /* The reflected branch is not followed, but a light seen along
+             * it (a light's image in the glass) has edges the grid must
+             * find: its part joins the signature. */
+            vec3f rd = f3_sub(d, f3_scale(n, 2.0f * f3_dot(d, n)));
+            hit hr = accel_intersect(rs, ray_offset(x, n), rd);
+            (*rays)++;
+            rs_part rtmp;
+            if (hr.part >= 0 && rs_prim(rs, hr.part, &rtmp)->is_light) {
+                sig = (sig ^ (uint32_t)(zone_surface_of(rs, hr.part) + 1) ^ 0x9e3779b9u) *
+                      16777619u;
+                if (glint)
+                    *glint = 1;
+            }
+            d = media_refract(d, n, cos_o, eta);
+            o = ray_offset(x, f3_neg(n));
+            inside = leaving ? -1 : p->object;
+        } else {
+            d = f3_sub(d, f3_scale(n, 2.0f * f3_dot(d, n)));
+            o = ray_offset(x, n);
+        }
+    }
+    return sig;
+}
+
+typedef struct seen_lights {
+    int part[SEEN_MAX];
+    double cover[SEEN_MAX]; /* measured coverage, or -1: computed exactly */
+    int count;
+} seen_lights;
+
+/* Light parts seen in a pixel get their exact coverage; a mesh light's
+ * triangles are shaded on the samples instead (a pixel may see many). */
+static void note_light(const rscene *rs, seen_lights *s, int part)
+{
+    if (part < 0 || part >= rs->part_count || !rs->parts[part].is_light)
+        return;
+    for (int i = 0; i < s->count; i++)
+        if (s->part[i] == part)
+            return;
+    if (s->count < SEEN_MAX) {
+        s->cover[s->count] = -1.0;
+        s->part[s->count++] = part;
+    }
+}
+
+static int push_sample(const rscene *rs_of_row, p2_row *row, vec3f o, vec3f d, hit h, double w)
+{
+    if (row->sample_count == row->sample_capacity) {
+        size_t cap = row->sample_capacity ? 2 * row->sample_capacity : 1024;
+        p2_sample *ns = realloc(row->samples, cap * sizeof *ns);
+        if (!ns)
+            return 0;
+        row->samples = ns;
+        row->sample_capacity = cap;
+    }
+    p2_sample s = {o, d, h.t, h.part, h.part < 0 ? -1 : zone_surface_of(rs_of_row, h.part), w};
+    row->samples[row->sample_count++] = s;
+    return 1;
+}
+
+static int push_lights(p2_row *row, const seen_lights *s)
+{
+    if (row->light_count + (size_t)s->count > row->light_capacity) {
+        size_t cap = row->light_capacity ? 2 * row->light_capacity : 64;
+        while (cap < row->light_count + (size_t)s->count)
+            cap *= 2;
+        int *nl = realloc(row->lights, cap * sizeof *nl);
+        if (!nl)
+            return 0;
+        row->lights = nl;
+        double *nc = realloc(row->light_cover, cap * sizeof *nc);
+        if (!nc)
+            return 0;
+        row->light_cover = nc;
+        row->light_capacity = cap;
+    }
+    for (int i = 0; i < s->count; i++) {
+        row->lights[row->light_count] = s->part[i];
+        row->light_cover[row->light_count++] = s->cover[i];
+    }
+    return 1;
+}
+
+/* Pushes pixel (px, py)'s g x g samples while they all have signature
+ * `first`; sets *edge when one does not, *curved when one meets a sphere.
+ * Returns 0 when out of memory. */
+static int grid_samples(const p2_ctx *c, int px, int py, int g, uint32_t first,
+                        seen_lights *lights, p2_row *row, uint64_t *rays, int *edge, int *curved)
+{
+    const rscene *rs = &c->r->rs;
+    vec3f org, dir;
+    hit h;
+    for (int sy = 0; sy < g; sy++)
+        for (int sx = 0; sx < g; sx++) {
+            cam_ray(&c->c, (float)px + (sx + 0.5f) / g, (float)py + (sy + 0.5f) / g, &org, &dir);
+            if (ray_signature(rs, org, dir, rays, &h, curved, NULL) != first)
+                *edge = 1;
+            note_light(rs, lights, h.part);
+            if (!*edge && !push_sample(rs, row, org, dir, h, 1.0 / (g * g)))
+                return 0;
+        }
+    return 1;
+}
+
+/* Scratch for one edge pixel's coverage grid (about 112 KB). */
+typedef struct edge_grid {
+    uint32_t sig[FINE_GRID * FINE_GRID], group_sig[FINE_GRID * FINE_GRID];
+    hit hits[FINE_GRID * FINE_GRID];
+    int group_of[FINE_GRID * FINE_GRID], group_count[FINE_GRID * FINE_GRID];
+    int group_shaded[FINE_GRID * FINE_GRID];
+} edge_grid;
+
+/* Point i of an edge pixel's n x n coverage points, in [0, 1)^2: the
+ * centre of cell i, or the i-th point of Roberts' R2 sequence (additive
+ * recurrence on the plastic number), whose every prefix is spread evenly
+ * and which lines up with no edge direction. */
+static void cover_point(int quasi, int n, int i, float *u, float *v)
+{
+    if (quasi) {
+        const double g = 1.32471795724474602596; /* x^3 = x + 1 */
+        double a = 0.5 + i / g, b = 0.5 + i / (g * g);
+        *u = (float)(a - floor(a));
+        *v = (float)(b - floor(b));
+    } else {
+        *u = (i % n + 0.5f) / n;
+        *v = (i / n + 0.5f) / n;
+    }
+}
+
+/* Whether coverage point i is shaded: every (n / shade)-th cell per side,
+ * or the first shade^2 points of the sequence. */
+static int cover_shaded(int quasi, int n, int shade, int i)
+{
+    if (quasi)
+        return i < shade * shade;
+    int step = n / shade, sx = i % n, sy = i / n;
+    return sx % step == step / 2 && sy % step == step / 2;
+}
+
+/* Samples of an edge pixel from n x n coverage points, shaded on a
+ * shade x shade subset.  *glint is set when some sub-pixel sees a light by
+ * way of a specular surface, *rim when a light and a sphere are both seen
+ * first.  With `measure`, the lights' coverage is taken from the grid. */
+static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_grid *e,
+                        seen_lights *lights, p2_row *row, uint64_t *rays, int *glint,
+                        int *rim, int measure)
+{
+    int saw_light = 0, saw_sphere = 0;
+    const rscene *rs = &c->r->rs;
+    const int cells = n * n, quasi = c->f->q.cover_quasi;
+    int groups = 0;
+    vec3f org, dir;
+    float u, v;
+    for (int i = 0; i < cells; i++) {
+        int via = 0;
+        cover_point(quasi, n, i, &u, &v);
+        cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
+        e->sig[i] = ray_signature(rs, org, dir, rays, &e->hits[i], NULL, &via);
+        *glint |= via;
+        note_light(rs, lights, e->hits[i].part);
+        if (e->hits[i].part >= 0) {
+            rs_part tmp;
+            const rs_part *hp = rs_prim(rs, e->hits[i].part, &tmp);
+            saw_light |= hp->is_light;
+            saw_sphere |= !hp->is_light && hp->shape == SHAPE_SPHERE;
+        }
+        int k = 0;
+        while (k < groups && e->group_sig[k] != e->sig[i])
+            k++;
+        if (k == groups) {
+            e->group_sig[k] = e->sig[i];
+            e->group_count[k] = 0;
+            e->group_shaded[k] = 0;
+            groups++;
+        }
+        e->group_of[i] = k;
+        e->group_count[k]++;
+        if (cover_shaded(quasi, n, shade, i))
+            e->group_shaded[k]++;
+    }
+    *rim = saw_light && saw_sphere;
+    if (measure)
+        for (int l = 0; l < lights->count; l++) {
+            int count = 0;
+            for (int i = 0; i < cells; i++)
+                count += e->hits[i].part == lights->part[l];
+            lights->cover[l] = (double)count / cells;
+        }
+    /* The subset's samples, weighted by their group's coverage. */
+    for (int i = 0; i < cells; i++) {
+        int k = e->group_of[i];
+        if (!cover_shaded(quasi, n, shade, i))
+            continue;
+        cover_point(quasi, n, i, &u, &v);
+        cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
+        double w = (double)e->group_count[k] / ((double)e->group_shaded[k] * cells);
+        if (!push_sample(rs, row, org, dir, e->hits[i], w))
+            return 0;
+    }
+    /* Surfaces too small to meet the subset: the point nearest their
+     * centroid (their first point lies on their rim, where what they show
+     * can differ most from their mean). */
+    for (int k = 0; k < groups; k++) {
+        if (e->group_shaded[k])
+            continue;
+        double cx = 0, cy = 0;
+        for (int i = 0; i < cells; i++)
+            if (e->group_of[i] == k) {
+                cover_point(quasi, n, i, &u, &v);
+                cx += u;
+                cy += v;
+            }
+        cx /= e->group_count[k];
+        cy /= e->group_count[k];
+        int best = -1;
+        double best_d2 = 1e300;
+        for (int i = 0; i < cells; i++) {
+            if (e->group_of[i] != k)
+                continue;
+            cover_point(quasi, n, i, &u, &v);
+            double dx = u - cx, dy = v - cy, d2 = dx * dx + dy * dy;
+            if (d2 < best_d2) {
+                best = i;
+                best_d2 = d2;
+            }
+        }
+        cover_point(quasi, n, best, &u, &v);
+        cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
+        if (!push_sample(rs, row, org, dir, e->hits[best], (double)e->group_count[k] / cells))
+            return 0;
+    }
+    return 1;
+}
+
+/* The samples of pixel (px, py) given its corner signatures. */
+static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners[4],
+                         seen_lights *lights, p2_row *row, edge_grid **scratch, uint64_t *rays)
+{
+    int g = c->g;
+    uint32_t first = corners[0];
+    int edge = corners[1] != first || corners[2] != first || corners[3] != first ||
+               (c->marks && c->marks->vertex[(size_t)py * c->c.width + px]);
+    /* A light's image may fall here, too small for the signatures. */
+    int marked = c->marks && c->marks->fine[(size_t)py * c->c.width + px];
+    size_t start = row->sample_count;
+    int curved = 0;
+    int probe = c->f->q.probe;
+    if (!edge && !marked && probe > g) {
+        /* More signatures than samples: a thin surface or a sliver of
+         * light between shadows can pass between the g x g samples. */
+        const rscene *rs = &c->r->rs;
+        for (int k = 0; k < probe * probe && !edge; k++) {
+            vec3f org, dir;
+            hit h;
+            cam_ray(&c->c, (float)px + (k % probe + 0.5f) / probe,
+                    (float)py + (k / probe + 0.5f) / probe, &org, &dir);
+            edge = ray_signature(rs, org, dir, rays, &h, NULL, NULL) != first;
+        }
+    }
+    if (!grid_samples(c, px, py, g, first, lights, row, rays, &edge, &curved))
+        return 0;
+    if (!edge && curved && g < CURVED_GRID) {
+        /* A sphere on the way: what the pixel sees (a reflection, a
+         * refraction, shading over a curved surface) changes within it
+         * faster than one sample can tell. */
+        row->sample_count = start;
+        if (!grid_samples(c, px, py, CURVED_GRID, first, lights, row, rays, &edge, &curved))
+            return 0;
+    }
+    if (!edge && !marked)
+        return 1;
+    row->sample_count = start;
+
+    if (!*scratch && !(*scratch = malloc(sizeof(edge_grid))))
+        return 0;
+    int glint = 0, rim = 0;
+    if (!edge_samples(c, px, py, c->f->q.edge_grid, c->f->q.edge_shade, *scratch, lights, row,
+                      rays, &glint, &rim, 0))
+        return 0;
+    if (glint || rim || marked) {
+        /* A light seen in a mirror or through glass: its image is the
+         * brightest thing around and often a few sub-pixels wide, so its
+         * coverage is measured on a grid 16 times as fine, and shaded on
+         * 16 times as many samples (near a sphere's rim what it shows
+         * swings fast).  A light beside a sphere: the exact coverage
+         * outlines the sphere by a polygon, the grid by rays; the two would
+         * leave slivers between them, so both come from the fine grid. */
+        row->sample_count = start;
+        if (!edge_samples(c, px, py, FINE_GRID, FINE_SHADE, *scratch, lights, row, rays, &glint,
+                          &rim, rim))
+            return 0;
+    }
+    return 1;
+}
+
+int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
+{
+    const rscene *rs = &c->r->rs;
+    int w = c->c.width, w1 = w + 1;
+    if (!row->pixel_first) {
+        row->width = w;
+        row->pixel_first = malloc((size_t)w1 * sizeof *row->pixel_first);
+        row->light_first = malloc((size_t)w1 * sizeof *row->light_first);
+        row->corner = malloc(2 * (size_t)w1 * sizeof *row->corner);
+        row->corner_part = malloc(2 * (size_t)w1 * sizeof *row->corner_part);
+        if (!row->pixel_first || !row->light_first || !row->corner || !row->corner_part)
+            return 0;
+    }
+    row->sample_count = 0;
+    row->light_count = 0;
+    /* Edge pixels' grids: scratch for this row only, as the zone strategy
+     * keeps every row of the image. */
+    edge_grid *scratch = NULL;
+    /* Signatures at the pixel corners of this row (top and bottom). */
+    for (int k = 0; k < 2 * w1; k++) {
+        vec3f org, dir;
+        hit h;
+        cam_ray(&c->c, (float)(k % w1), (float)(y + k / w1), &org, &dir);
+        row->corner[k] = ray_signature(rs, org, dir, rays, &h, NULL, NULL);
+        row->corner_part[k] = h.part;
+    }
+    for (int x = 0; x < w; x++) {
+        uint32_t cs[4] = {row->corner[x], row->corner[x + 1], row->corner[w1 + x],
+                          row->corner[w1 + x + 1]};
+        seen_lights lights = {{0}, {0}, 0};
+        note_light(rs, &lights, row->corner_part[x]);
+        note_light(rs, &lights, row->corner_part[x + 1]);
+        note_light(rs, &lights, row->corner_part[w1 + x]);
+        note_light(rs, &lights, row->corner_part[w1 + x + 1]);
+        if (c->marks) {
+            const uint64_t *tips;
+            int n = p2_marks_tips(c->marks, (size_t)y * w + x, &tips);
+            for (int k = 0; k < n; k++)
+                note_light(rs, &lights, (int)(tips[k] & 0xffffffffu));
+        }
+        row->pixel_first[x] = row->sample_count;
+        row->light_first[x] = row->light_count;
+        if (!pixel_samples(c, x, y, cs, &lights, row, &scratch, rays) ||
+            !push_lights(row, &lights)) {
+            free(scratch);
+            return 0;
+        }
+    }
+    free(scratch);
+    row->pixel_first[w] = row->sample_count;
+    row->light_first[w] = row->light_count;
+    return 1;
+}
+
+void p2_row_free(p2_row *row)
+{
+    free(row->samples);
+    free(row->pixel_first);
+    free(row->lights);
+    free(row->light_cover);
+    free(row->light_first);
+    free(row->corner);
+    free(row->corner_part);
+    memset(row, 0, sizeof *row);
+}

@@ -1,0 +1,167 @@
+/* The zone tracer's state, shared by its stages: the forest (Phase One's
+ * result: the zones and the irradiance at the nodes of every diffuse
+ * surface, level by level) and what Phase Two reads from it.
+ * docs/zone-tracer.md describes what is computed and why. */
+#ifndef ZT_ZONE_ZONE_H
+#define ZT_ZONE_ZONE_H
+
+#include <stdint.h>
+
+#include "render/render_internal.h"
+#include "zone/light/direct.h"
+#include "zone/light/occluders.h"
+#include "zone/maps/surface_nodes.h"
+#include "zone/transfer/sender_tree.h"
+
+/* Up to this many light primitives, direct light sums them all exactly;
+ * beyond (a mesh light), a cut through the light tree chooses which to
+ * take exactly and which together. */
+#define ZONE_LIGHTS_EXACT 16
+
+/* How light leaves a zone's source. */
+typedef enum zone_kind {
+    ZONE_EMIT = 0,      /* a root: the light primitive itself */
+    ZONE_DIFFUSE,
+    ZONE_METALLIC,
+    ZONE_MIRROR,
+    ZONE_REFRACT,       /* the dielectric lobe: reflected and transmitted */
+    ZONE_KINDS
+} zone_kind;
+
+/* One zone: the light leaving a source by one kind of interaction, at one
+ * level.  A root (level 0) is a light primitive.  Above, there is one zone
+ * per surface, lobe and level: light that leaves a surface diffusely has
+ * forgotten where it came from, so the diffuse zone of a surface is fed by
+ * every zone of the level below (its light is the surface's irradiance at
+ * that level); a specular zone passes the level below on along the
+ * reflected and refracted rays, so its light keeps a direction. */
+typedef struct zone {
+    int32_t source;     /* root: the light primitive; else the surface
+                           (zone_surface_of) */
+    uint8_t kind;       /* zone_kind */
+    uint8_t level;
+    float power;        /* the power it carries (a bound for specular
+                           zones), for --cutoff */
+} zone;
+
+/* Surfaces: each part is one; a mesh's triangles of one material (one
+ * object of rs) together are one. */
+static inline int zone_surface_count(const rscene *rs)
+{
+    return rs->part_count + rs->object_count;
+}
+int zone_surface_of(const rscene *rs, int prim);
+
+/* Quality settings derived from --quality. */
+typedef struct zone_quality {
+    int gather;         /* directions per node for light by specular
+                           surfaces and the sky */
+    double texel;       /* node spacing h in scene units */
+    double texel_divisor; /* h = scene extent / texel_divisor */
+    int max_texels;     /* nodes along a plane's core at most */
+    int sides;          /* polygon vertices for disks */
+    int aa;             /* sub-pixel grid per side */
+    double theta;       /* transfer: an element is split above this size
+                           over distance */
+    double eps;         /* transfer: a cluster's error bound, as a share of
+                           the receiver's irradiance */
+    int fallback;       /* direct light by rays: light cut into this many
+                           triangles where occluders are too many to clip */
+    int glint_cuts;     /* a light triangle is cut n x n for its images */
+    int edge_grid;      /* coverage grid of a pixel an edge crosses (<= 64) */
+    int edge_shade;     /* its shaded subset, per side (divides edge_grid) */
+    int cover_quasi;    /* coverage points: 0 the n x n cell centres, 1 the
+                           first n^2 of a quasi-random (R2) sequence */
+    int probe;          /* signatures per side that look for an edge in a
+                           pixel (no more than aa: the samples' own) */
+    int photons;        /* caustic photons per light (caustic.h) */
+} zone_quality;
+
+typedef struct zone_forest {
+    zone *zones;
+    int zone_count, zone_capacity;
+    uint64_t pruned;
+    surface_nodes sn;
+    int map_levels;     /* irradiance levels E_0 .. E_{map_levels-1} */
+    float *e;           /* [level][node][rgb] */
+    occluder_index occ;
+    direct_ctx direct;
+    sender_tree light_tree; /* the lights, when there are many */
+    zone_quality q;
+    int need_gather;    /* some light arrives by specular surfaces */
+    int sky;            /* the sky is not black: E_0 gathers it */
+    int *glint_spheres; /* spheres that reflect lights as images (glint.h) */
+    int glint_count;
+    vec3 *dirs;         /* the gather directions (q.gather of them) */
+    uint64_t links;     /* Phase One: clusters and elements the transfer took */
+    double phase_one_seconds;
+    uint64_t rays;
+    int loaded;         /* read from a forest file (forest_io.c), not built */
+    double build_seconds; /* Phase One time of the build (kept in the file) */
+    int images;         /* images rendered from it so far */
+} zone_forest;
+
+/* Level l's irradiance at node k. */
+static inline float *zone_e(const zone_forest *f, int level, int32_t k)
+{
+    return f->e + ((size_t)level * (size_t)f->sn.node_count + (size_t)k) * 3;
+}
+
+/* The quality settings of --quality q for scene sc (rs compiled from it). */
+zone_quality zone_quality_for(const zt_scene *sc, const rscene *rs, int q);
+
+/* The scene's core: the box of the finite primitives and of the corners
+ * where three planes meet; independent of the camera. */
+void zone_scene_bounds(const zt_scene *sc, const rscene *rs, vec3 *lo, vec3 *hi);
+
+/* Phase One (phase_one/phase_one.c): the nodes, their irradiance level by
+ * level, and the zones. */
+zt_status zone_phase_one(zone_forest *f, const zt_renderer *r, zt_error *err);
+/* The zones from the irradiance (phase_one/forest.c). */
+zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err);
+/* What the forest holds besides its zones and levels, rebuilt the same on
+ * load: nodes, occluders, gather directions, glint spheres. */
+zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err);
+void zone_forest_free(zone_forest *f);
+/* The fixed gather directions (cosine-weighted, around +z). */
+vec3 *zone_gather_directions(int n);
+
+/* Radiance arriving along a ray with levels lo..hi (flags below). */
+typedef struct zone_trace {
+    const zone_forest *f;
+    const zt_renderer *r;
+    uint64_t rays;
+} zone_trace;
+
+/* Irradiance of level `level` at point x (normal n) on side `side` of
+ * primitive prim, read from the nodes. */
+vec3 zone_map_read(const zone_forest *f, const rscene *rs, int level, int prim, int side, vec3 x);
+
+/* The sky's direct irradiance at x (normal n), gathered over the forest's
+ * directions. */
+vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n);
+/* The direct irradiance of every light (exact, direct.c; a light cut when
+ * there are many) at x (normal n) on primitive `receiver`, without the
+ * sky's. */
+vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n);
+
+enum {
+    ZR_EXACT_DIRECT = 1, /* level 1 from the analytic direct term, not maps */
+    ZR_NO_EMISSION = 2,  /* lights hit by this very ray count nothing (the
+                            camera's level 0 is measured analytically) */
+    ZR_SKIP_DIFFUSE = 4, /* the diffuse lobe of the surface hit by this very
+                            ray counts nothing (the transfer covers it) */
+    ZR_NO_GLINT = 8,     /* a light seen in a glint sphere (glint.h) by this
+                            very ray counts nothing (its image covers it) */
+    ZR_NO_CAUSTIC = 16,  /* a light reached after one or more specular events
+                            and no diffuse one, the last of them off a
+                            caustic target (caustic.h), counts nothing if it
+                            sends photons (a triangle or sphere): they carry
+                            it */
+    ZR_CAUSTIC_LIGHT = 32 /* set by zone_radiance under ZR_NO_CAUSTIC: this
+                            very ray left a caustic target */
+};
+vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
+                   int flags, const int *media, int media_count);
+
+#endif
