@@ -78,6 +78,17 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
         rs_part tmp;
         const rs_part *p = rs_prim(rs, h.part, &tmp);
         const rs_object *m = &rs->objects[p->object];
+        /* A flat-shaded mesh's creases are edges: its facets join the
+         * signature by their plane's direction, so coplanar neighbours (a
+         * quad's two triangles) still look like one surface.  A smooth
+         * mesh's shading is continuous across its triangles. */
+        if (h.part >= rs->part_count && !rs_mesh_of(rs, h.part)->smooth) {
+            vec3f gn = shape_normal(p, f3_madd(o, d, h.t));
+            uint32_t q = (uint32_t)lrintf(gn.x * 256.0f) * 73856093u ^
+                         (uint32_t)lrintf(gn.y * 256.0f) * 19349663u ^
+                         (uint32_t)lrintf(gn.z * 256.0f) * 83492791u;
+            sig = (sig ^ q) * 16777619u;
+        }
         if (curved && p->shape == SHAPE_SPHERE)
             *curved = 1;
         if (p->is_light && k > 0 && glint)
