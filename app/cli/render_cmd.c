@@ -318,6 +318,9 @@ int cli_render(int argc, char **argv)
         if (info.rough_materials)
             fprintf(stderr, "note: %d model materials have a roughness, which is ignored: "
                     "metal, mirror and glass lobes are smooth\n", info.rough_materials);
+        if (info.missing_textures)
+            fprintf(stderr, "note: %d model textures are missing or unreadable and were left "
+                    "out (%s)\n", info.missing_textures, info.texture_problem);
         fprintf(stderr, "method %s, depth %d, level %s%d\n",
                 opt.method == ZT_METHOD_PATH ? "path" : "zone", opt.depth,
                 opt.level < 0 ? "all up to " : "", opt.level < 0 ? opt.depth : opt.level);

@@ -56,6 +56,9 @@ typedef struct zt_scene_info {
     long long skipped_triangles; /* degenerate ones the import left out */
     int rough_materials; /* materials whose roughness the smooth lobes
                             cannot represent (it is ignored) */
+    int missing_textures; /* textures a model names but that are missing or
+                             cannot be decoded (left out: base colour only) */
+    char texture_problem[160]; /* the first of them and why */
     int has_sky;      /* non-zero when a sky colour is given */
 } zt_scene_info;
 

@@ -1,6 +1,7 @@
 /* Scene model: construction, copies, queries and rigid motions. */
 #include "scene/scene.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -162,6 +163,9 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
         out->mesh_triangles += m->triangle_count;
         out->skipped_triangles += m->skipped_degenerate;
         out->rough_materials += m->rough_slots;
+        if (m->missing_textures && !out->missing_textures)
+            snprintf(out->texture_problem, sizeof out->texture_problem, "%s", m->texture_problem);
+        out->missing_textures += m->missing_textures;
         for (int t = 0; t < m->triangle_count; t++) {
             int light = o->is_light || !v3_is_black(m->slots[mesh_slot_of(m, t)].emission);
             if (light)
