@@ -123,9 +123,7 @@ int mesh_make_unique(mesh **m)
     return 1;
 }
 
-/* The inverse transpose of a (row-major), up to a positive factor: its
- * cofactor matrix, times the sign of the determinant. */
-static double cofactors(const double a[9], double c[9])
+double mesh_cofactors(const double a[9], double c[9])
 {
     c[0] = a[4] * a[8] - a[5] * a[7];
     c[1] = a[5] * a[6] - a[3] * a[8];
@@ -149,7 +147,7 @@ void mesh_transform(mesh *m, const double a[9], const double t[3])
         p[2] = (float)(a[6] * x + a[7] * y + a[8] * z + t[2]);
     }
     double c[9];
-    double det = cofactors(a, c);
+    double det = mesh_cofactors(a, c);
     if (m->normal) {
         double s = det < 0 ? -1.0 : 1.0;
         for (int v = 0; v < m->vertex_count; v++) {

@@ -85,6 +85,11 @@ int mesh_make_unique(mesh **m);
  * stays the side the normals point to.  The mesh must be unique. */
 void mesh_transform(mesh *m, const double a[9], const double t[3]);
 
+/* The cofactor matrix of a (row-major 3x3): the inverse transpose times
+ * the determinant, which it returns.  Normals go by it (its sign flips
+ * them back when the map mirrors). */
+double mesh_cofactors(const double a[9], double c[9]);
+
 /* The box of the positions; lo > hi on every axis for an empty mesh. */
 void mesh_bounds(const mesh *m, vec3 *lo, vec3 *hi);
 

@@ -62,20 +62,12 @@ static void transform_point(const struct aiMatrix4x4 *t, const struct aiVector3D
     out[2] = (double)t->c1 * p->x + (double)t->c2 * p->y + (double)t->c3 * p->z + t->c4;
 }
 
-/* The inverse transpose of t's 3x3 part (cofactors), and its determinant. */
+/* The inverse transpose of t's 3x3 part (times its determinant, which it
+ * returns). */
 static double normal_matrix(const struct aiMatrix4x4 *t, double c[9])
 {
     double a[9] = {t->a1, t->a2, t->a3, t->b1, t->b2, t->b3, t->c1, t->c2, t->c3};
-    c[0] = a[4] * a[8] - a[5] * a[7];
-    c[1] = a[5] * a[6] - a[3] * a[8];
-    c[2] = a[3] * a[7] - a[4] * a[6];
-    c[3] = a[2] * a[7] - a[1] * a[8];
-    c[4] = a[0] * a[8] - a[2] * a[6];
-    c[5] = a[1] * a[6] - a[0] * a[7];
-    c[6] = a[1] * a[5] - a[2] * a[4];
-    c[7] = a[2] * a[3] - a[0] * a[5];
-    c[8] = a[0] * a[4] - a[1] * a[3];
-    return a[0] * c[0] + a[1] * c[1] + a[2] * c[2];
+    return mesh_cofactors(a, c);
 }
 
 static zt_status failf(flatten *f, const char *fmt, const char *detail, long long a, long long b,
