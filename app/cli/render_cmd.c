@@ -315,6 +315,9 @@ int cli_render(int argc, char **argv)
         if (info.meshes)
             fprintf(stderr, "meshes: %d, %lld triangles (%lld degenerate ones skipped)\n",
                     info.meshes, info.mesh_triangles, info.skipped_triangles);
+        if (info.replaced_normals)
+            fprintf(stderr, "note: %lld vertex normals of the models were not finite or "
+                    "zero and were replaced by the faces' normals\n", info.replaced_normals);
         if (info.rough_materials)
             fprintf(stderr, "note: %d model materials have a roughness, which is ignored: "
                     "metal, mirror and glass lobes are smooth\n", info.rough_materials);

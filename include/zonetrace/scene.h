@@ -54,6 +54,8 @@ typedef struct zt_scene_info {
     int meshes;       /* objects made from model files */
     long long mesh_triangles; /* their triangles */
     long long skipped_triangles; /* degenerate ones the import left out */
+    long long replaced_normals; /* vertex normals of a model that were not
+                                   finite or zero, replaced from the faces */
     int rough_materials; /* materials whose roughness the smooth lobes
                             cannot represent (it is ignored) */
     int missing_textures; /* textures a model names but that are missing or

@@ -53,6 +53,8 @@ typedef struct mesh {
     int texture_count;
     /* What the import dropped or could not represent (for -v). */
     int skipped_degenerate; /* zero-area or repeated-vertex triangles */
+    int replaced_normals;   /* vertex normals not finite or zero in the file,
+                               replaced by the faces' normals */
     int rough_slots;        /* slots whose roughness was ignored */
     int missing_textures;   /* textures named but missing or undecodable */
     char texture_problem[160]; /* the first such texture and why */

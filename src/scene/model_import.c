@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <pthread.h>
 #include <sys/stat.h>
 
 #include <assimp/cimport.h>
@@ -19,6 +20,35 @@
 
 #include "scene/model_materials.h"
 #include "util/error.h"
+
+/* Assimp repairs some broken files and only says so in its log (faces with
+ * out-of-range indices are dropped): the importer listens to the log while
+ * it reads.  The log is global to the process, so imports take turns. */
+static pthread_mutex_t import_lock = PTHREAD_MUTEX_INITIALIZER;
+
+typedef struct import_log {
+    int dropped_faces;      /* Assimp dropped faces with bad indices */
+} import_log;
+
+static void log_message(const char *message, char *user)
+{
+    import_log *log = (import_log *)(void *)user;
+    if (strstr(message, "out-of-range indices"))
+        log->dropped_faces = 1;
+}
+
+/* aiImportFile with the log heard. */
+static const struct aiScene *import_listening(const char *path, unsigned flags, import_log *log)
+{
+    memset(log, 0, sizeof *log);
+    pthread_mutex_lock(&import_lock);
+    struct aiLogStream stream = {log_message, (char *)(void *)log};
+    aiAttachLogStream(&stream);
+    const struct aiScene *sc = aiImportFile(path, flags);
+    aiDetachLogStream(&stream);
+    pthread_mutex_unlock(&import_lock);
+    return sc;
+}
 
 /* Node hierarchies deeper than this are taken for cycles or mistakes. */
 #define MAX_NODE_DEPTH 256
@@ -32,6 +62,8 @@ typedef struct flatten {
     int slots;
     int any_normals, any_uv;
     int skipped;
+    int bad_normals;        /* vertex normals in the file that are not finite
+                               or zero (replaced from the faces) */
     const char *path;
     zt_error *err;
     zt_status status;
@@ -123,7 +155,9 @@ static zt_status add_mesh(flatten *f, unsigned mi, const struct aiMatrix4x4 *t)
         if (m->normal) {
             float *nn = m->normal + 3 * ((size_t)base + v);
             nn[0] = nn[1] = nn[2] = 0; /* filled from the faces below when missing */
-            if (am->mNormals && is_finite3(&am->mNormals[v])) {
+            if (am->mNormals && !is_finite3(&am->mNormals[v]))
+                f->bad_normals++;
+            else if (am->mNormals) {
                 const struct aiVector3D *s = &am->mNormals[v];
                 double sg = det < 0 ? -1 : 1;
                 double x = sg * (nm[0] * s->x + nm[1] * s->y + nm[2] * s->z);
@@ -134,6 +168,8 @@ static zt_status add_mesh(flatten *f, unsigned mi, const struct aiMatrix4x4 *t)
                     nn[0] = (float)(x / l);
                     nn[1] = (float)(y / l);
                     nn[2] = (float)(z / l);
+                } else {
+                    f->bad_normals++;
                 }
             }
         }
@@ -369,11 +405,17 @@ zt_status model_import(const char *path, const model_import_options *options, me
                      aiProcess_SortByPType | aiProcess_ValidateDataStructure;
     if (options->smooth)
         flags |= aiProcess_GenSmoothNormals;
-    const struct aiScene *sc = aiImportFile(path, flags);
+    import_log log;
+    const struct aiScene *sc = import_listening(path, flags, &log);
     if (!sc) {
         const char *why = aiGetErrorString();
         return zt_fail(err, ZT_ERR_PARSE, "%s: the model cannot be read: %s", path,
                        why && why[0] ? why : "Assimp gives no reason");
+    }
+    if (log.dropped_faces) {
+        aiReleaseImport(sc);
+        return zt_fail(err, ZT_ERR_PARSE, "%s: the model cannot be read: some faces have "
+                       "vertex indices out of range", path);
     }
     flatten f;
     memset(&f, 0, sizeof f);
@@ -410,6 +452,7 @@ zt_status model_import(const char *path, const model_import_options *options, me
     }
     if (st == ZT_OK) {
         m->skipped_degenerate = f.skipped;
+        m->replaced_normals = f.bad_normals;
         if (m->triangle_count == 0)
             st = zt_fail(err, ZT_ERR_PARSE, "%s: the model has no triangles left (%d were "
                          "degenerate or had vertices that are not finite)", path, f.skipped);

@@ -162,6 +162,7 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
         out->meshes++;
         out->mesh_triangles += m->triangle_count;
         out->skipped_triangles += m->skipped_degenerate;
+        out->replaced_normals += m->replaced_normals;
         out->rough_materials += m->rough_slots;
         if (m->missing_textures && !out->missing_textures)
             snprintf(out->texture_problem, sizeof out->texture_problem, "%s", m->texture_problem);
