@@ -17,6 +17,7 @@
 #include "geom/shapes.h"
 #include "render/render_scene.h"
 #include "scene/scene.h"
+#include "bench_rays.h"
 
 enum {
     CAMERA_RAYS = 1 << 16,
@@ -30,103 +31,6 @@ static const struct {
     accel_kind kind;
     const char *name;
 } BACKENDS[] = {{ACCEL_BRUTE, "brute"}, {ACCEL_EMBREE, "embree"}, {ACCEL_BVH, "bvh"}};
-
-typedef struct bench_ray {
-    vec3f o, d;
-    float dist;  /* visibility rays: the target's distance */
-    int bg;      /* and whether it is in the background */
-} bench_ray;
-
-typedef struct ray_set {
-    bench_ray *nearest, *any;
-    int n_nearest, n_any;
-} ray_set;
-
-static float rnd(uint32_t *s)
-{
-    *s ^= *s << 13;
-    *s ^= *s >> 17;
-    *s ^= *s << 5;
-    return (float)(*s >> 8) * (1.0f / 16777216.0f);
-}
-
-/* Cosine-weighted about n, as a diffuse bounce samples. */
-static vec3f bounce(vec3f n, uint32_t *s)
-{
-    vec3f t, b;
-    f3_basis(n, &t, &b);
-    float r = sqrtf(rnd(s)), phi = 6.2831853f * rnd(s);
-    float z = sqrtf(fmaxf(0.0f, 1.0f - r * r));
-    return f3_add(f3_scale(n, z), f3_add(f3_scale(t, r * cosf(phi)), f3_scale(b, r * sinf(phi))));
-}
-
-typedef struct surface_point {
-    vec3f x, n; /* n faces the side the ray came from */
-    int bg;
-} surface_point;
-
-static int record_hit(const rscene *rs, vec3f o, vec3f d, surface_point *out)
-{
-    hit h = accel_intersect(rs, o, d);
-    if (h.part < 0)
-        return 0;
-    const rs_part *p = &rs->parts[h.part];
-    out->x = f3_madd(o, d, h.t);
-    out->n = shape_normal(p, out->x);
-    if (f3_dot(out->n, d) > 0.0f)
-        out->n = f3_neg(out->n);
-    out->bg = p->background;
-    return 1;
-}
-
-static void make_rays(const rscene *rs, const zt_scene *scene, ray_set *set)
-{
-    uint32_t seed = 2024;
-    zt_camera c = zt_scene_get_camera(scene);
-    vec3f eye = f3((float)c.viewpoint[0], (float)c.viewpoint[1], (float)c.viewpoint[2]);
-    set->nearest = malloc(2 * CAMERA_RAYS * sizeof *set->nearest);
-    set->any = malloc(2 * CAMERA_RAYS * sizeof *set->any);
-    surface_point *pts = malloc(2 * CAMERA_RAYS * sizeof *pts);
-    if (!set->nearest || !set->any || !pts) {
-        fprintf(stderr, "out of memory\n");
-        exit(1);
-    }
-    int n = 0, hits = 0;
-    for (int i = 0; i < CAMERA_RAYS; i++) {
-        float u = rnd(&seed), v = rnd(&seed), p[3];
-        for (int k = 0; k < 3; k++)
-            p[k] = (float)(c.screen[0][k] + u * (c.screen[1][k] - c.screen[0][k]) +
-                           v * (c.screen[2][k] - c.screen[0][k]));
-        bench_ray *r = &set->nearest[n++];
-        r->o = f3(p[0], p[1], p[2]);
-        r->d = f3_normalize(f3_sub(r->o, eye));
-        hits += record_hit(rs, r->o, r->d, &pts[hits]);
-    }
-    int first_bounce = hits;
-    for (int i = 0; i < first_bounce; i++) {
-        bench_ray *r = &set->nearest[n++];
-        r->d = bounce(pts[i].n, &seed);
-        r->o = ray_offset(pts[i].x, pts[i].n);
-        hits += record_hit(rs, r->o, r->d, &pts[hits]);
-    }
-    set->n_nearest = n;
-    /* Visibility between random pairs of hit points, stopping just short
-     * of the target as a shadow ray does. */
-    set->n_any = 0;
-    for (int i = 0; i < hits && hits > 1; i++) {
-        const surface_point *a = &pts[i], *b = &pts[(int)(rnd(&seed) * (float)hits)];
-        vec3f to = f3_sub(b->x, a->x);
-        float len = f3_length(to);
-        if (len <= 0.0f)
-            continue;
-        bench_ray *r = &set->any[set->n_any++];
-        r->d = f3_scale(to, 1.0f / len);
-        r->o = ray_offset(a->x, f3_dot(r->d, a->n) >= 0.0f ? a->n : f3_neg(a->n));
-        r->dist = 0.9999f * len;
-        r->bg = b->bg;
-    }
-    free(pts);
-}
 
 /* Million rays per second over at least MIN_SECONDS, best of RUNS. */
 static double throughput(const rscene *rs, const ray_set *set, int any, int threads)
@@ -165,7 +69,7 @@ static void bench_scene(const char *name, const zt_scene *scene)
         return;
     }
     ray_set set;
-    make_rays(&rs, scene, &set);
+    bench_make_rays(&rs, scene, CAMERA_RAYS, &set);
     int prims = rs.part_count - rs.planes[0].count - rs.planes[1].count;
     int all = omp_get_max_threads();
     for (size_t k = 0; k < sizeof BACKENDS / sizeof BACKENDS[0]; k++) {
@@ -185,8 +89,7 @@ static void bench_scene(const char *name, const zt_scene *scene)
                throughput(&rs, &set, 1, 1), throughput(&rs, &set, 1, all));
         fflush(stdout);
     }
-    free(set.nearest);
-    free(set.any);
+    bench_free_rays(&set);
     rscene_free(&rs);
 }
 
@@ -265,10 +168,10 @@ static zt_scene *soup_scene(void)
     add_object(s, 0, 0);
     uint32_t seed = 7;
     for (int i = 0; i < 100000; i++) {
-        vec3 a = v3(16 * rnd(&seed) - 8, 16 * rnd(&seed) - 8, 16 * rnd(&seed) - 8);
+        vec3 a = v3(16 * bench_rnd(&seed) - 8, 16 * bench_rnd(&seed) - 8, 16 * bench_rnd(&seed) - 8);
         vec3 e[2];
         for (int k = 0; k < 2; k++)
-            e[k] = v3(0.6 * rnd(&seed) - 0.3, 0.6 * rnd(&seed) - 0.3, 0.6 * rnd(&seed) - 0.3);
+            e[k] = v3(0.6 * bench_rnd(&seed) - 0.3, 0.6 * bench_rnd(&seed) - 0.3, 0.6 * bench_rnd(&seed) - 0.3);
         add_triangle(s, a, v3_add(a, e[0]), v3_add(a, e[1]));
     }
     return s;

@@ -350,11 +350,16 @@ int cli_render(int argc, char **argv)
         return cli_exit_code(st);
     }
     if (!quiet) {
-        double rps = stats.seconds > 0 ? stats.rays / stats.seconds : 0;
-        fprintf(stderr, "rendered %s in %.3f s: %llu samples, %llu rays, %.2f Mrays/s, %d threads\n",
+        /* The path tracer's rays per second count the tracing alone: on a
+         * large model the acceleration build can take longer than the
+         * image.  The zone tracer's rays include Phase One's. */
+        double t = opt.method == ZT_METHOD_PATH ? stats.trace_seconds : stats.seconds;
+        double rps = t > 0 ? stats.rays / t : 0;
+        fprintf(stderr, "rendered %s in %.3f s (%.3f s preparing the scene): %llu samples, "
+                "%llu rays, %.2f Mrays/s, %d threads\n",
                 strcmp(output, "-") ? output : "(stdout)", stats.seconds,
-                (unsigned long long)stats.samples, (unsigned long long)stats.rays,
-                rps / 1e6, stats.threads);
+                stats.seconds - stats.trace_seconds, (unsigned long long)stats.samples,
+                (unsigned long long)stats.rays, rps / 1e6, stats.threads);
     }
     if (verbose && opt.method == ZT_METHOD_ZONE)
         print_zone_stats(&stats, opt.forest_file);

@@ -67,6 +67,9 @@ zt_render_options zt_render_options_default(void);
 
 typedef struct zt_render_stats {
     double seconds;        /* wall time of the whole render */
+    double trace_seconds;  /* of which rendering the image itself (the rest
+                              prepares the scene: acceleration structure,
+                              and for the zone tracer Phase One) */
     uint64_t samples;      /* camera samples taken */
     uint64_t rays;         /* rays traced (camera, extension and shadow) */
     int threads;           /* threads used */

@@ -133,6 +133,7 @@ zt_status zt_renderer_accumulate(zt_renderer *r, int first, int count, zt_image 
                        ? path_accumulate(r, first, count, sum, stats, err)
                        : zone_accumulate(r, sum, stats, err);
     stats->seconds = render_clock() - t0;
+    stats->trace_seconds = stats->seconds;
     return st;
 }
 

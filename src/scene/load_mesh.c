@@ -146,7 +146,7 @@ zt_status load_mesh_item(load_ctx *ctx, jref item, jref body, int line)
 
     char path[4096];
     model_path(ctx, json_string_value(file.value), path, sizeof path);
-    model_import_options opt = {smooth};
+    model_import_options opt = {.smooth = smooth};
     mesh *m = NULL;
     zt_error ierr;
     zt_error_clear(&ierr);

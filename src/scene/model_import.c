@@ -13,6 +13,7 @@
 #include <strings.h>
 #include <pthread.h>
 #include <sys/stat.h>
+#include <time.h>
 
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
@@ -406,7 +407,12 @@ zt_status model_import(const char *path, const model_import_options *options, me
     if (options->smooth)
         flags |= aiProcess_GenSmoothNormals;
     import_log log;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     const struct aiScene *sc = import_listening(path, flags, &log);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (options->read_seconds)
+        *options->read_seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec);
     if (!sc) {
         const char *why = aiGetErrorString();
         return zt_fail(err, ZT_ERR_PARSE, "%s: the model cannot be read: %s", path,

@@ -19,6 +19,9 @@ typedef struct model_import_options {
     int smooth;             /* keep the file's vertex normals (and make
                                smooth ones where it has none); 0: flat,
                                mesh->normal = NULL */
+    double *read_seconds;   /* when not NULL, receives the time Assimp took
+                               to read and post-process the file (the
+                               benchmarks report it apart from the rest) */
 } model_import_options;
 
 /* Reads `path` into a new mesh (*out, the caller's: mesh_release), with

@@ -37,7 +37,7 @@ static zt_status frame_model(const mesh *m, zt_camera *cam, zt_error *err)
 zt_status scene_from_model(const char *path, zt_scene **out, zt_error *err)
 {
     *out = NULL;
-    model_import_options opt = {1};
+    model_import_options opt = {.smooth = 1};
     model_camera mc;
     memset(&mc, 0, sizeof mc);
     mesh *m = NULL;
