@@ -70,10 +70,10 @@ static void bench_scene(const char *name, const zt_scene *scene)
     }
     ray_set set;
     bench_make_rays(&rs, scene, CAMERA_RAYS, &set);
-    int prims = rs.part_count - rs.planes[0].count - rs.planes[1].count;
+    int prims = rs.prim_count - rs.planes[0].count - rs.planes[1].count;
     int all = omp_get_max_threads();
     for (size_t k = 0; k < sizeof BACKENDS / sizeof BACKENDS[0]; k++) {
-        if (BACKENDS[k].kind == ACCEL_BRUTE && rs.part_count > BRUTE_MAX_PARTS)
+        if (BACKENDS[k].kind == ACCEL_BRUTE && rs.prim_count > BRUTE_MAX_PARTS)
             continue;
         accel_free(rs.accel);
         rs.accel = NULL;
