@@ -18,7 +18,7 @@ scenes=("$@")
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-secs() { sed -n 's/.* in \([0-9.]*\) s:.*/\1/p' "$1"; }
+secs() { sed -n 's/.* in \([0-9.]*\) s[ :].*/\1/p' "$1"; }
 err() { "$zt" compare "$1" "$2" | sed -n 's/^rel_rmse //p'; }
 
 printf '%-28s %9s %9s %9s %10s %10s %9s\n' scene phase1_s phase2_s zone_s zone_err path_s speedup

@@ -2,8 +2,9 @@
  * triangles as a binary little-endian PLY with vertex normals, as a
  * modeller would export it.
  *
- *   gen_mesh N out.ply
+ *   gen_mesh [--plain] N out.ply
  *
+ * --plain leaves the bumps out: a UV sphere of radius 1.
  * The sphere is a grid of rings (u around, v from pole to pole) displaced
  * by a few sines, so that neighbouring triangles differ in size and
  * orientation as on a scanned or sculpted model; the seam and the poles
@@ -17,10 +18,13 @@
 
 #define PI 3.14159265358979323846
 
+static int plain;
+
 static void surface(double th, double ph, double p[3])
 {
-    double bump = 0.04 * sin(7 * th) * sin(9 * ph) + 0.02 * sin(23 * th + 1) * sin(19 * ph) +
-                  0.01 * sin(61 * th) * sin(57 * ph + 2);
+    double bump = plain ? 0.0
+                        : 0.04 * sin(7 * th) * sin(9 * ph) + 0.02 * sin(23 * th + 1) * sin(19 * ph) +
+                              0.01 * sin(61 * th) * sin(57 * ph + 2);
     double r = 1.0 + bump;
     p[0] = r * sin(th) * cos(ph);
     p[1] = r * cos(th);
@@ -54,8 +58,13 @@ static int put(FILE *f, const void *p, size_t n)
 
 int main(int argc, char **argv)
 {
+    if (argc == 4 && strcmp(argv[1], "--plain") == 0) {
+        plain = 1;
+        argv++;
+        argc--;
+    }
     if (argc != 3) {
-        fprintf(stderr, "usage: gen_mesh TRIANGLES OUT.ply\n");
+        fprintf(stderr, "usage: gen_mesh [--plain] TRIANGLES OUT.ply\n");
         return 1;
     }
     char *end;
