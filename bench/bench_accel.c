@@ -32,32 +32,9 @@ static const struct {
     const char *name;
 } BACKENDS[] = {{ACCEL_BRUTE, "brute"}, {ACCEL_EMBREE, "embree"}, {ACCEL_BVH, "bvh"}};
 
-/* Million rays per second over at least MIN_SECONDS, best of RUNS. */
 static double throughput(const rscene *rs, const ray_set *set, int any, int threads)
 {
-    const bench_ray *rays = any ? set->any : set->nearest;
-    int n = any ? set->n_any : set->n_nearest;
-    if (n == 0)
-        return 0.0;
-    double best = 0.0;
-    long sink = 0;
-    for (int run = 0; run < RUNS; run++) {
-        long passes = 0;
-        double t0 = omp_get_wtime(), t;
-        do {
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 512) reduction(+ : sink)
-            for (int i = 0; i < n; i++)
-                sink += any ? accel_occluded(rs, rays[i].o, rays[i].d, rays[i].dist,
-                                             rays[i].bg)
-                            : accel_intersect(rs, rays[i].o, rays[i].d).part;
-            passes++;
-            t = omp_get_wtime() - t0;
-        } while (t < MIN_SECONDS);
-        best = fmax(best, (double)passes * n / t / 1e6);
-    }
-    if (sink == 42) /* keeps the work from being optimised away */
-        fputc(' ', stderr);
-    return best;
+    return bench_throughput(set, any, threads, bench_trace_accel, rs, RUNS, MIN_SECONDS);
 }
 
 static void bench_scene(const char *name, const zt_scene *scene)

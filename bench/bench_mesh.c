@@ -73,8 +73,9 @@ static double raw_build(raw_embree *e, const mesh *m)
     return omp_get_wtime() - t0;
 }
 
-static long raw_trace(const raw_embree *e, const bench_ray *r, int any)
+static long raw_trace(const void *raw, const bench_ray *r, int any)
 {
+    const raw_embree *e = raw;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
@@ -94,33 +95,6 @@ static long raw_trace(const raw_embree *e, const bench_ray *r, int any)
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(e->scene, &ctx, &rh);
     return (long)rh.hit.primID;
-}
-
-/* Million rays per second, best of RUNS runs of at least MIN_SECONDS. */
-static double throughput(const rscene *rs, const raw_embree *raw, const ray_set *set, int any,
-                         int threads)
-{
-    const bench_ray *rays = any ? set->any : set->nearest;
-    int n = any ? set->n_any : set->n_nearest;
-    double best = 0.0;
-    long sink = 0;
-    for (int run = 0; run < RUNS && n > 0; run++) {
-        long passes = 0;
-        double t0 = omp_get_wtime(), t;
-        do {
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1024) reduction(+ : sink)
-            for (int i = 0; i < n; i++)
-                sink += raw ? raw_trace(raw, &rays[i], any)
-                     : any  ? accel_occluded(rs, rays[i].o, rays[i].d, rays[i].dist, rays[i].bg)
-                            : accel_intersect(rs, rays[i].o, rays[i].d).part;
-            passes++;
-            t = omp_get_wtime() - t0;
-        } while (t < MIN_SECONDS);
-        best = fmax(best, (double)passes * n / t / 1e6);
-    }
-    if (sink == 42) /* keeps the work from being optimised away */
-        fputc(' ', stderr);
-    return best;
 }
 
 /* The model under a white sky, seen from the front-right and above. */
@@ -209,8 +183,8 @@ int main(int argc, char **argv)
     double ours[4], theirs[4];
     for (int k = 0; k < 4; k++) {
         int any = k >= 2, th = k % 2 ? threads : 1;
-        ours[k] = throughput(&rs, NULL, &set, any, th);
-        theirs[k] = throughput(NULL, &raw, &set, any, th);
+        ours[k] = bench_throughput(&set, any, th, bench_trace_accel, &rs, RUNS, MIN_SECONDS);
+        theirs[k] = bench_throughput(&set, any, th, raw_trace, &raw, RUNS, MIN_SECONDS);
     }
     printf("  %-28s %10.2f %10.2f %10.2f %10.2f\n", "accel_intersect/occluded", ours[0],
            ours[1], ours[2], ours[3]);

@@ -21,17 +21,16 @@ ns=("$@")
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-# The Cornell box's scene list with the sphere added as its last item.
+# The Cornell box with the sphere added as the scene list's last item (the
+# file ends with the list's "]" and the top level's "}", one per line).
 scene() {
-  python3 - "$here/../scenes/cornell.json" "$1" "$2" <<'EOF'
-import json, sys
-s = json.load(open(sys.argv[1]))
-s["scene"].append({"mesh": {"file": sys.argv[2], "material": {
-    "character": {"diffuse": 1, "metallic": 0, "reflecting": 0, "refractive": 0},
-    "color": [0.75, 0.75, 0.75]},
-    "transform": {"scale": 60, "translate": [185, 250, 170]}}})
-json.dump(s, open(sys.argv[3], "w"), indent=1)
-EOF
+  {
+    sed '$d' "$here/../scenes/cornell.json" | sed '$d'
+    printf '    ,{"mesh": {"file": "%s", "transform": {"scale": 60, "translate": [185, 250, 170]},\n' "$1"
+    printf '       "material": {"character": {"diffuse": 1, "metallic": 0, "reflecting": 0,\n'
+    printf '                                  "refractive": 0}, "color": [0.75, 0.75, 0.75]}}}\n'
+    printf '    ]\n}\n'
+  } > "$2"
 }
 err() { "$zt" compare "$1" "$2" | sed -n 's/^rel_rmse //p'; }
 

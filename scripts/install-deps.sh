@@ -15,6 +15,7 @@ packages=(
   libsdl2-dev                        # the interactive viewer's window
   libcmocka-dev                      # the test framework
   xvfb xauth                         # an X server for the viewer's tests
+  time                               # /usr/bin/time: peak memory in bench/zone_nseries.sh
 )
 
 missing=()

@@ -2,6 +2,7 @@
 #include "bench_rays.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -103,4 +104,34 @@ void bench_free_rays(ray_set *set)
     free(set->nearest);
     free(set->any);
     set->nearest = set->any = NULL;
+}
+
+long bench_trace_accel(const void *rs, const bench_ray *r, int any)
+{
+    return any ? accel_occluded(rs, r->o, r->d, r->dist, r->bg)
+               : accel_intersect(rs, r->o, r->d).part;
+}
+
+double bench_throughput(const ray_set *set, int any, int threads, bench_trace_fn trace,
+                        const void *ctx, int runs, double min_seconds)
+{
+    const bench_ray *rays = any ? set->any : set->nearest;
+    int n = any ? set->n_any : set->n_nearest;
+    double best = 0.0;
+    long sink = 0;
+    for (int run = 0; run < runs && n > 0; run++) {
+        long passes = 0;
+        double t0 = omp_get_wtime(), t;
+        do {
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 512) reduction(+ : sink)
+            for (int i = 0; i < n; i++)
+                sink += trace(ctx, &rays[i], any);
+            passes++;
+            t = omp_get_wtime() - t0;
+        } while (t < min_seconds);
+        best = fmax(best, (double)passes * n / t / 1e6);
+    }
+    if (sink == 42) /* keeps the work from being optimised away */
+        fputc(' ', stderr);
+    return best;
 }

@@ -4,6 +4,7 @@
  * four) with the leaves' primitives packed into packets of four. */
 #include "geom/bvh.h"
 #include "render/prim.h"
+#include "util/select_nth.h"
 
 #include <float.h>
 #include <math.h>
@@ -201,28 +202,7 @@ static void swap_refs(prim_ref *a, prim_ref *b)
     *b = t;
 }
 
-/* Reorders refs[lo, hi) so that refs[nth] has the nth centre on axis. */
-static void select_nth(prim_ref *refs, int lo, int hi, int nth, int axis)
-{
-    while (hi - lo > 1) {
-        float pivot = centre(&refs[lo + (hi - lo) / 2], axis);
-        int i = lo, j = hi - 1;
-        while (i <= j) {
-            while (centre(&refs[i], axis) < pivot)
-                i++;
-            while (centre(&refs[j], axis) > pivot)
-                j--;
-            if (i <= j)
-                swap_refs(&refs[i++], &refs[j--]);
-        }
-        if (nth <= j)
-            hi = j + 1;
-        else if (nth >= i)
-            lo = i;
-        else
-            return;
-    }
-}
+DEFINE_SELECT_NTH(select_nth, prim_ref, centre)
 
 /* Where to split refs[begin, end) (node bounds nb, centroid bounds cb), or
  * 0 for a leaf. */
@@ -257,7 +237,7 @@ static int choose_split(builder *b, int begin, int end, const box *nb,
         if (cb->hi[a] - cb->lo[a] > cb->hi[axis] - cb->lo[axis])
             axis = a;
     int mid = begin + n / 2;
-    select_nth(b->refs, begin, end, mid, axis);
+    select_nth(b->refs + begin, end - begin, mid - begin, axis);
     return mid;
 }
 

@@ -301,6 +301,19 @@ static int light_polygon(const direct_ctx *c, int light, vec3 x, light_frame *f,
     return 1;
 }
 
+/* occlude_with for primitive i under the background rule: background
+ * objects never block foreground lights; foreground objects block
+ * background lights even beyond them. */
+static int occlude_by(const direct_ctx *c, int i, const zprim *light, const light_frame *f,
+                      vec3 x, vec3 n, const frustum *fr, poly2_set *set, poly2 *scratch)
+{
+    zprim o;
+    zprim_get(c->scene, c->rs, i, &o);
+    if (o.background && !light->background)
+        return 0;
+    return occlude_with(c, f, x, n, &o, light->background && !o.background, fr, set, scratch);
+}
+
 static vec3 lift(const light_frame *f, double a, double b)
 {
     return v3_add(f->origin, v3_add(v3_scale(f->u, a), v3_scale(f->v, b)));
@@ -356,35 +369,18 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
         region.hi = v3(INFINITY, INFINITY, INFINITY);
     }
     /* Infinite planes are few and in no index. */
-    for (int i = 0; i < sc->part_count; i++) {
-        if (i == receiver || i == light || sc->parts[i].shape != SHAPE_PLANE)
-            continue;
-        zprim o;
-        zprim_get(sc, c->rs, i, &o);
-        if (o.background && !lpp.background)
-            continue;
-        int beyond = lpp.background && !o.background;
-        if (occlude_with(c, f, x, n, &o, beyond, &fr, set, scratch))
+    for (int i = 0; i < sc->part_count; i++)
+        if (i != receiver && i != light && sc->parts[i].shape == SHAPE_PLANE &&
+            occlude_by(c, i, &lpp, f, x, n, &fr, set, scratch))
             return 0;
-    }
     int32_t cand[DIRECT_MAX_OCCLUDERS];
     int found = occluders_query(c->occ, &region, cand, DIRECT_MAX_OCCLUDERS);
     if (found > DIRECT_MAX_OCCLUDERS)
         return -1;
-    for (int k = 0; k < found; k++) {
-        int i = cand[k];
-        if (i == receiver || i == light)
-            continue;
-        zprim o;
-        zprim_get(sc, c->rs, i, &o);
-        /* The background rule: background objects block foreground lights
-         * never; foreground objects block background lights even beyond. */
-        if (o.background && !lpp.background)
-            continue;
-        int beyond = lpp.background && !o.background;
-        if (occlude_with(c, f, x, n, &o, beyond, &fr, set, scratch))
+    for (int k = 0; k < found; k++)
+        if (cand[k] != receiver && cand[k] != light &&
+            occlude_by(c, cand[k], &lpp, f, x, n, &fr, set, scratch))
             return 0;
-    }
     return set->overflow ? -1 : 1;
 }
 

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "render/prim.h"
+#include "util/select_nth.h"
 
 #define LEAF_SIZE 4
 
@@ -45,34 +46,9 @@ static void prim_box(const rs_part *p, ref *r)
     }
 }
 
-/* Quickselect: refs[k] is the one that would be there sorted by axis a. */
-static void select_nth(ref *refs, int n, int k, int a)
-{
-    int lo = 0, hi = n - 1;
-    while (lo < hi) {
-        float pivot = refs[(lo + hi) / 2].c[a];
-        int i = lo, j = hi;
-        while (i <= j) {
-            while (refs[i].c[a] < pivot)
-                i++;
-            while (refs[j].c[a] > pivot)
-                j--;
-            if (i <= j) {
-                ref t = refs[i];
-                refs[i] = refs[j];
-                refs[j] = t;
-                i++;
-                j--;
-            }
-        }
-        if (k <= j)
-            hi = j;
-        else if (k >= i)
-            lo = i;
-        else
-            return;
-    }
-}
+static float ref_centre(const ref *r, int axis) { return r->c[axis]; }
+
+DEFINE_SELECT_NTH(select_nth, ref, ref_centre)
 
 typedef struct builder {
     occluder_index *ix;

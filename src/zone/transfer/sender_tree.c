@@ -9,6 +9,7 @@
 
 #include "material/texture.h"
 #include "render/prim.h"
+#include "util/select_nth.h"
 #include "util/vec3_convert.h"
 
 #define LEAF_SIZE 2
@@ -163,33 +164,8 @@ static double elems_cone(const sender_elem *el, int n)
     return th;
 }
 
-static void select_nth(sender_elem *el, int n, int k, int a)
-{
-    int lo = 0, hi = n - 1;
-    while (lo < hi) {
-        float pivot = elem_c(&el[(lo + hi) / 2], a);
-        int i = lo, j = hi;
-        while (i <= j) {
-            while (elem_c(&el[i], a) < pivot)
-                i++;
-            while (elem_c(&el[j], a) > pivot)
-                j--;
-            if (i <= j) {
-                sender_elem t = el[i];
-                el[i] = el[j];
-                el[j] = t;
-                i++;
-                j--;
-            }
-        }
-        if (k <= j)
-            hi = j;
-        else if (k >= i)
-            lo = i;
-        else
-            return;
-    }
-}
+/* Axes 0-2 are the centre's, 3-5 the normal's. */
+DEFINE_SELECT_NTH(select_nth, sender_elem, elem_c)
 
 /* Fills node ni with elements [first, first + n). */
 static void build(builder *b, int32_t ni, int first, int n, int depth)
