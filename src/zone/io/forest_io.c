@@ -15,120 +15,12 @@
 #include <unistd.h>
 
 #include "scene/mesh.h"
+#include "scene/scene_hash.h"
+#include "util/fnv1a.h"
 #include "util/error.h"
 
 static const char MAGIC[8] = {'Z', 'T', 'F', 'O', 'R', 'E', 'S', 'T'};
 #define BYTE_ORDER_MARK 0x01020304u
-
-/* ---- hashing: 64-bit FNV-1a over little-endian values ---- */
-
-typedef struct hasher { uint64_t h; } hasher;
-
-static void h_bytes(hasher *h, const unsigned char *b, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        h->h ^= b[i];
-        h->h *= 0x100000001b3ull;
-    }
-}
-
-static void h_u64(hasher *h, uint64_t v)
-{
-    unsigned char b[8];
-    for (int i = 0; i < 8; i++)
-        b[i] = (unsigned char)(v >> (8 * i));
-    h_bytes(h, b, 8);
-}
-
-static void h_i32(hasher *h, int v) { h_u64(h, (uint64_t)(int64_t)v); }
-
-static void h_f64(hasher *h, double v)
-{
-    uint64_t u;
-    memcpy(&u, &v, 8);
-    h_u64(h, u);
-}
-
-static void h_v3(hasher *h, vec3 v)
-{
-    h_f64(h, v.x);
-    h_f64(h, v.y);
-    h_f64(h, v.z);
-}
-
-uint64_t forest_scene_hash(const zt_scene *sc)
-{
-    hasher h = {0xcbf29ce484222325ull};
-    h_i32(&h, sc->object_count);
-    h_i32(&h, sc->part_count);
-    for (int i = 0; i < sc->object_count; i++) {
-        const object *o = &sc->objects[i];
-        h_i32(&h, o->is_light);
-        h_i32(&h, o->index);
-        h_i32(&h, o->background);
-        h_i32(&h, o->backculled);
-        for (int k = 0; k < LOBE_COUNT; k++)
-            h_f64(&h, o->mat.weight[k]);
-        h_v3(&h, o->mat.color);
-        h_f64(&h, o->mat.ior);
-        h_v3(&h, o->emission);
-        h_i32(&h, o->first_part);
-        h_i32(&h, o->part_count);
-    }
-    for (int i = 0; i < sc->part_count; i++) {
-        const part *p = &sc->parts[i];
-        h_i32(&h, (int)p->shape);
-        h_i32(&h, p->object);
-        for (int k = 0; k < 3; k++)
-            h_v3(&h, p->p[k]);
-        h_f64(&h, p->radius);
-        h_v3(&h, p->normal);
-        h_f64(&h, p->offset);
-    }
-    /* Meshes: every array, the materials and the texture texels. */
-    h_i32(&h, sc->mesh_count);
-    for (int i = 0; i < sc->object_count; i++) {
-        const object *o = &sc->objects[i];
-        h_i32(&h, o->mesh);
-        if (o->mesh < 0)
-            continue;
-        const mesh *m = sc->meshes[o->mesh];
-        h_i32(&h, m->vertex_count);
-        h_i32(&h, m->triangle_count);
-        h_bytes(&h, (const unsigned char *)m->position, (size_t)m->vertex_count * 3 * sizeof(float));
-        h_i32(&h, m->normal != NULL);
-        if (m->normal)
-            h_bytes(&h, (const unsigned char *)m->normal, (size_t)m->vertex_count * 3 * sizeof(float));
-        h_i32(&h, m->uv != NULL);
-        if (m->uv)
-            h_bytes(&h, (const unsigned char *)m->uv, (size_t)m->vertex_count * 2 * sizeof(float));
-        h_bytes(&h, (const unsigned char *)m->index, (size_t)m->triangle_count * 3 * sizeof(uint32_t));
-        h_i32(&h, m->slot != NULL);
-        if (m->slot)
-            h_bytes(&h, (const unsigned char *)m->slot, (size_t)m->triangle_count * sizeof(uint16_t));
-        h_i32(&h, m->slot_count);
-        for (int k = 0; k < m->slot_count; k++) {
-            const mesh_slot *sl = &m->slots[k];
-            for (int l = 0; l < LOBE_COUNT; l++)
-                h_f64(&h, sl->mat.weight[l]);
-            h_v3(&h, sl->mat.color);
-            h_f64(&h, sl->mat.ior);
-            h_v3(&h, sl->emission);
-            h_i32(&h, sl->texture);
-        }
-        h_i32(&h, m->texture_count);
-        for (int k = 0; k < m->texture_count; k++) {
-            const mesh_texture *t = &m->textures[k];
-            h_i32(&h, t->width);
-            h_i32(&h, t->height);
-            h_i32(&h, t->wrap);
-            h_bytes(&h, t->rgba, (size_t)t->width * t->height * 4);
-        }
-    }
-    h_v3(&h, sc->sky);
-    h_i32(&h, sc->has_sky);
-    return h.h;
-}
 
 /* The options that shape the forest, in a canonical form. */
 typedef struct forest_options {
@@ -171,20 +63,20 @@ static void options_of(const zt_render_options *o, const zone_quality *q, forest
 
 static uint64_t options_hash(const forest_options *fo)
 {
-    hasher h = {0xcbf29ce484222325ull};
-    h_i32(&h, fo->depth);
-    h_i32(&h, fo->quality);
-    h_f64(&h, fo->cutoff);
-    h_i32(&h, fo->lights_off_count);
+    fnv1a h = {FNV1A_START};
+    fnv_i32(&h, fo->depth);
+    fnv_i32(&h, fo->quality);
+    fnv_f64(&h, fo->cutoff);
+    fnv_i32(&h, fo->lights_off_count);
     for (int i = 0; i < fo->lights_off_count; i++)
-        h_i32(&h, fo->lights_off[i]);
-    h_i32(&h, fo->gather);
-    h_i32(&h, fo->sides);
-    h_i32(&h, fo->aa);
-    h_f64(&h, fo->texel_divisor);
-    h_f64(&h, fo->theta);
-    h_f64(&h, fo->eps);
-    h_i32(&h, fo->fallback);
+        fnv_i32(&h, fo->lights_off[i]);
+    fnv_i32(&h, fo->gather);
+    fnv_i32(&h, fo->sides);
+    fnv_i32(&h, fo->aa);
+    fnv_f64(&h, fo->texel_divisor);
+    fnv_f64(&h, fo->theta);
+    fnv_f64(&h, fo->eps);
+    fnv_i32(&h, fo->fallback);
     return h.h;
 }
 
@@ -261,7 +153,7 @@ static void write_header(wbuf *w, const zone_forest *f, const zt_renderer *r,
     w_u32(w, FOREST_FILE_VERSION);
     w_u32(w, BYTE_ORDER_MARK);
     w_u64(w, 0); /* file size, patched at the end */
-    w_u64(w, forest_scene_hash(r->scene));
+    w_u64(w, scene_hash(r->scene));
     w_u64(w, options_hash(fo));
     w_i32(w, r->scene->object_count);
     w_i32(w, r->scene->part_count);
@@ -314,9 +206,9 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
     if (!w.failed)
         for (int i = 0; i < 8; i++)
             w.b[16 + i] = (unsigned char)(size >> (8 * i));
-    hasher h = {0xcbf29ce484222325ull};
+    fnv1a h = {FNV1A_START};
     if (!w.failed)
-        h_bytes(&h, w.b, w.n);
+        fnv_bytes(&h, w.b, w.n);
     w_u64(&w, h.h);
     if (w.failed) {
         free(w.b);
@@ -574,15 +466,15 @@ zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *
         goto done;
     }
     {
-        hasher h = {0xcbf29ce484222325ull};
-        h_bytes(&h, data, n - 8);
+        fnv1a h = {FNV1A_START};
+        fnv_bytes(&h, data, n - 8);
         rbuf tail = {data + n - 8, 8, 0, 0};
         if (h.h != r_u64(&tail)) {
             st = corrupt(err, path, "checksum mismatch");
             goto done;
         }
     }
-    uint64_t scene_hash = r_u64(&rb), opt_hash = r_u64(&rb);
+    uint64_t file_scene_hash = r_u64(&rb), opt_hash = r_u64(&rb);
     int objects = r_i32(&rb), parts = r_i32(&rb), prims = r_i32(&rb);
     forest_options file;
     memset(&file, 0, sizeof file);
@@ -608,7 +500,7 @@ zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *
         goto done;
     }
     const zt_scene *sc = r->scene;
-    if (scene_hash != forest_scene_hash(sc)) {
+    if (file_scene_hash != scene_hash(sc)) {
         if (objects != sc->object_count || parts != sc->part_count || prims != r->rs.prim_count)
             st = zt_fail(err, ZT_ERR_PARSE, "forest file '%s' was made for another scene (%d "
                          "objects, %d primitives; this scene has %d objects, %d primitives)",
@@ -694,10 +586,11 @@ zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *
         int bad = 0;
         for (size_t k = 0; k < nn; k++) {
             bad |= live[k] > 1;
-            /* A node may move a hair off a wall, never far. */
+            /* Node life moves a node on a seam between walls a quarter
+             * cell into the room (node_life.c), never farther. */
             for (int a = 0; a < 3; a++)
                 bad |= !(fabsf(pos[3 * k + a] - f->sn.pos[3 * k + a]) <=
-                         (float)f->q.texel * 0.01f + 1e-6f * fabsf(f->sn.pos[3 * k + a]));
+                         (float)(0.3 * f->sn.h) + 1e-6f * fabsf(f->sn.pos[3 * k + a]));
         }
         for (size_t k = 0; k < (size_t)levels * nn * 3; k++)
             bad |= !isfinite(f->e[k]);

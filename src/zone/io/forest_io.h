@@ -23,9 +23,6 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
 zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *expect,
                       const char *path, zt_error *err);
 
-/* 64-bit FNV-1a of the scene's geometry, materials, lights and sky (not
- * the camera), meshes and their textures included. */
-uint64_t forest_scene_hash(const zt_scene *sc);
 
 /* Bytes held by the zones, the nodes, their irradiance and the occluder
  * index. */
