@@ -16,6 +16,7 @@ packages=(
   libcmocka-dev                      # the test framework
   xvfb xauth                         # an X server for the viewer's tests
   time                               # /usr/bin/time: peak memory in bench/zone_nseries.sh
+  clang libclang-rt-dev libomp-dev   # the fuzz harnesses (libFuzzer, OpenMP for clang)
 )
 
 missing=()

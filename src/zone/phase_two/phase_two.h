@@ -140,8 +140,10 @@ static inline void p2_row_pixel(const p2_row *row, int x, int y, p2_pixel *px)
     px->y = y;
     px->s = row->samples + row->pixel_first[x];
     px->n = (int)(row->pixel_first[x + 1] - row->pixel_first[x]);
-    px->lights = row->lights + row->light_first[x];
-    px->light_cover = row->light_cover + row->light_first[x];
+    /* A row with no light samples has NULL lists (no offset may be added
+     * to a null pointer, even zero). */
+    px->lights = row->lights ? row->lights + row->light_first[x] : NULL;
+    px->light_cover = row->light_cover ? row->light_cover + row->light_first[x] : NULL;
     px->nlights = (int)(row->light_first[x + 1] - row->light_first[x]);
 }
 
