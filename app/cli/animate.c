@@ -120,10 +120,20 @@ int cli_animate(const char *scene_path, const zt_render_options *options,
         goto done;
     }
 
+    /* An interrupt lets the frame under way finish (a frame cut short would
+     * not match its neighbours) and starts no other. */
     zt_render_options opt = *options;
+    opt.stop = NULL;
+    cli_interrupts_install();
     double total_seconds = 0;
     uint64_t total_rays = 0;
+    int frames_done = 0;
     for (int k = 0; k < anim->frames; k++) {
+        if (cli_stop) {
+            cli_error("interrupted: %d of %d frames written", frames_done, anim->frames);
+            code = EXIT_INTERRUPTED;
+            break;
+        }
         double t = anim->time + k / anim->fps;
         char name[4096];
         if (has_number)
@@ -160,12 +170,14 @@ int cli_animate(const char *scene_path, const zt_render_options *options,
         }
         total_seconds += stats.seconds;
         total_rays += stats.rays;
+        frames_done++;
         if (!quiet && !verbose)
             fprintf(stderr, ", %.2f s\n", stats.seconds);
+        cli_report_stop(&opt, &stats, quiet);
     }
-    if (!quiet)
+    if (!quiet && frames_done)
         fprintf(stderr, "rendered %d frame%s in %.3f s: %llu rays, %.2f Mrays/s\n",
-                anim->frames, anim->frames == 1 ? "" : "s", total_seconds,
+                frames_done, frames_done == 1 ? "" : "s", total_seconds,
                 (unsigned long long)total_rays,
                 total_seconds > 0 ? total_rays / total_seconds / 1e6 : 0.0);
 done:

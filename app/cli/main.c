@@ -25,6 +25,8 @@ int cli_exit_code(zt_status status)
     case ZT_ERR_READ: return EXIT_UNREADABLE;
     case ZT_ERR_PARSE: return EXIT_UNPARSEABLE;
     case ZT_ERR_WRITE: return EXIT_UNWRITABLE;
+    case ZT_ERR_MEMORY: return EXIT_MEMORY;
+    case ZT_ERR_UNSUPPORTED: return EXIT_UNSUPPORTED;
     default: return EXIT_FAILURE_OTHER;
     }
 }
@@ -39,8 +41,11 @@ void cli_error(const char *fmt, ...)
     va_end(ap);
 }
 
+double cli_start;
+
 int main(int argc, char **argv)
 {
+    cli_start = cli_now();
     if (argc < 2) {
         print_usage(stderr);
         return EXIT_USAGE;

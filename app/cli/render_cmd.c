@@ -60,21 +60,47 @@ static void render_usage(FILE *f)
 "      --fps F           frames per second of the animation (default 24)\n"
 "      --time T          time of the first frame in seconds (default 0)\n"
 "\n"
+"Long renders (docs/long-renders.md):\n"
+"      --time-limit S    finish within S seconds of starting, writing the image\n"
+"                        then: the path tracer renders whole passes of samples\n"
+"                        while the next fits (--spp is then an upper bound, at\n"
+"                        least 1 is taken); the zone tracer builds the levels\n"
+"                        that fit and says which depth it reached.  In an\n"
+"                        animation, S is per frame\n"
+"      --checkpoint FILE path tracer: save the running sums to FILE every few\n"
+"                        minutes, when interrupted and at the end\n"
+"      --checkpoint-every S\n"
+"                        seconds between checkpoints (default 300)\n"
+"      --resume FILE     continue the render saved in FILE (same scene, camera,\n"
+"                        seed, depth, level, lights-off; --spp at least its\n"
+"                        count) and keep checkpointing into it: the image is\n"
+"                        the same, bit for bit, as an uninterrupted render\n"
+"      --max-memory SIZE refuse, before any work, a render estimated to need\n"
+"                        more than SIZE (e.g. 8G; default: the physical memory)\n"
+"  Ctrl-C or SIGTERM once: the path tracer finishes its pass and writes the\n"
+"  image of the samples done (and the checkpoint); the zone tracer builds no\n"
+"  further level; an animation finishes its frame.  Twice: abort at once.\n"
+"\n"
 "Running:\n"
 "      --threads T       threads (default: all cores)\n"
 "  -v, --verbose         progress with ETA on stderr, and details\n"
 "  -q, --quiet           no statistics line\n"
 "  -h, --help            this text\n"
 "\n"
-"Exit status: 0 done, 1 bad arguments, 2 unreadable input, 3 invalid input,\n"
-"4 unwritable output, 5 other failure.\n");
+"Exit status: 0 done (also when a time limit cut it short), 1 bad arguments,\n"
+"2 unreadable input, 3 invalid input (scene, model, forest or checkpoint\n"
+"file), 4 unwritable output, 5 needs more memory than allowed (refused before\n"
+"the work), 6 not supported by this build, 7 other failure (or interrupted\n"
+"before any image), 8 interrupted: the image so far was written, 130 or 143\n"
+"interrupted twice (SIGINT, SIGTERM): nothing written.\n");
 }
 
 enum {
     OPT_SIZE = 256, OPT_SPP, OPT_DEPTH, OPT_LEVEL, OPT_SEED, OPT_THREADS,
     OPT_METHOD, OPT_GAMMA, OPT_EXPOSURE, OPT_STRATEGY, OPT_CUTOFF, OPT_QUALITY,
     OPT_LIGHTS_OFF, OPT_MOTIONS, OPT_FRAMES, OPT_FPS, OPT_TIME,
-    OPT_SAVE_FOREST = 400, OPT_LOAD_FOREST
+    OPT_SAVE_FOREST = 400, OPT_LOAD_FOREST,
+    OPT_TIME_LIMIT = 500, OPT_CHECKPOINT, OPT_CHECKPOINT_EVERY, OPT_RESUME, OPT_MAX_MEMORY
 };
 
 static const struct option long_options[] = {
@@ -98,6 +124,11 @@ static const struct option long_options[] = {
     {"frames", required_argument, 0, OPT_FRAMES},
     {"fps", required_argument, 0, OPT_FPS},
     {"time", required_argument, 0, OPT_TIME},
+    {"time-limit", required_argument, 0, OPT_TIME_LIMIT},
+    {"checkpoint", required_argument, 0, OPT_CHECKPOINT},
+    {"checkpoint-every", required_argument, 0, OPT_CHECKPOINT_EVERY},
+    {"resume", required_argument, 0, OPT_RESUME},
+    {"max-memory", required_argument, 0, OPT_MAX_MEMORY},
     {"verbose", no_argument, 0, 'v'},
     {"quiet", no_argument, 0, 'q'},
     {"help", no_argument, 0, 'h'},
@@ -194,8 +225,9 @@ int cli_render(int argc, char **argv)
     zt_tonemap tm = zt_tonemap_default();
     const char *output = "image.png";
     int width = 0, height = 0, verbose = 0, quiet = 0, depth_given = 0;
-    const char *forest_out = NULL;
-    unsigned long long seed = 0;
+    const char *forest_out = NULL, *checkpoint = NULL, *resume = NULL;
+    unsigned long long seed = 0, max_memory = 0;
+    double time_limit = 0;
     cli_animation anim = {NULL, 1, 24.0, 0.0, 0};
     int c;
     optind = 1;
@@ -237,6 +269,13 @@ int cli_render(int argc, char **argv)
         case OPT_FRAMES: ok = parse_int("--frames", optarg, 1, 1000000, &anim.frames); anim.given = 1; break;
         case OPT_FPS: ok = parse_double("--fps", optarg, 1e-3, 1e6, &anim.fps); anim.given = 1; break;
         case OPT_TIME: ok = parse_double("--time", optarg, 0, 1e9, &anim.time); anim.given = 1; break;
+        case OPT_TIME_LIMIT: ok = parse_double("--time-limit", optarg, 1e-3, 1e9, &time_limit); break;
+        case OPT_CHECKPOINT: checkpoint = optarg; break;
+        case OPT_CHECKPOINT_EVERY:
+            ok = parse_double("--checkpoint-every", optarg, 1e-3, 1e9, &opt.checkpoint_seconds);
+            break;
+        case OPT_RESUME: resume = optarg; break;
+        case OPT_MAX_MEMORY: ok = parse_bytes("--max-memory", optarg, &max_memory); break;
         case 'v': verbose = 1; break;
         case 'q': quiet = 1; break;
         case 'h': render_usage(stdout); return EXIT_OK;
@@ -277,6 +316,9 @@ int cli_render(int argc, char **argv)
                   "(--motions) need a forest per frame");
         return EXIT_USAGE;
     }
+    if (long_render_options(&opt, checkpoint, resume, time_limit, max_memory, &anim,
+                            forest_out != NULL) != EXIT_OK)
+        return EXIT_USAGE;
     int w = output_writable(output);
     if (w <= 0)
         return w < 0 ? EXIT_USAGE : EXIT_UNWRITABLE;
@@ -335,12 +377,22 @@ int cli_render(int argc, char **argv)
     }
     zt_image *img = NULL;
     zt_render_stats stats;
+    cli_interrupts_install();
+    opt.stop = &cli_stop;
+    if (time_limit > 0)
+        opt.time_limit = cli_time_left(time_limit, (long long)zt_scene_get_camera(scene).width *
+                                                        zt_scene_get_camera(scene).height);
     st = forest_out ? render_saving_forest(scene, &opt, forest_out, &img, &stats, &err)
                     : zt_render(scene, &opt, &img, &stats, &err);
     cli_progress_finish(&prog);
     zt_scene_release(scene);
     if (st != ZT_OK) {
         cli_error("%s", err.message);
+        if (st == ZT_ERR_MEMORY)
+            fprintf(stderr, "zonetrace: (--max-memory SIZE sets the limit; the estimate is "
+                    "in docs/long-renders.md)\n");
+        if (st == ZT_ERR_CANCELLED && cli_stop)
+            fprintf(stderr, "zonetrace: interrupted before any image: nothing written\n");
         return cli_exit_code(st);
     }
     st = zt_image_write(img, output, &tm, &err);
@@ -363,5 +415,6 @@ int cli_render(int argc, char **argv)
     }
     if (verbose && opt.method == ZT_METHOD_ZONE)
         print_zone_stats(&stats, opt.forest_file);
-    return EXIT_OK;
+    cli_report_stop(&opt, &stats, quiet);
+    return stats.stopped == ZT_STOP_INTERRUPT ? EXIT_INTERRUPTED : EXIT_OK;
 }

@@ -10,6 +10,7 @@
 #ifndef ZONETRACE_RENDER_H
 #define ZONETRACE_RENDER_H
 
+#include <signal.h>
 #include <stdint.h>
 #include "zonetrace/error.h"
 #include "zonetrace/image.h"
@@ -60,10 +61,43 @@ typedef struct zt_render_options {
      * with ZT_ERR_PARSE (ZT_ERR_READ when it cannot be read) and a message
      * naming the file and the reason.  Format: docs/zone-tracer.md. */
     const char *forest_file;
+
+    /* Long renders (docs/long-renders.md); zt_render only. */
+    /* Seconds the whole zt_render may take (0: no limit).  Path tracer:
+     * whole passes of samples while the next one fits, at least one sample
+     * per pixel; spp is then an upper bound.  Zone tracer: Phase One builds
+     * the levels that fit and the image has the depth reached (not with
+     * level >= 0).  stats say what was reached. */
+    double time_limit;
+    /* When not NULL and it becomes non-zero (a signal handler's flag): the
+     * path tracer finishes its pass and returns the image of the samples
+     * done; the zone tracer builds no further level. */
+    const volatile sig_atomic_t *stop;
+    /* Path tracer: the running sums and the sample count are written to this
+     * file (atomically) every checkpoint_seconds, when the render stops
+     * early and when it ends.  With resume, the render continues from the
+     * file, which must be for the same scene, camera, seed, depth, level and
+     * lights-off, with at most spp samples (else ZT_ERR_PARSE); the image
+     * is then bit for bit the one an uninterrupted render gives. */
+    const char *checkpoint_file;
+    double checkpoint_seconds; /* 0: 300 */
+    int resume;
+    /* Bytes the render may use (0: the machine's physical memory, or the
+     * control group's limit when lower).  A render whose estimate (image,
+     * scene, acceleration structure, zone forest) passes it fails before
+     * the work with ZT_ERR_MEMORY and a message with the size it needs. */
+    uint64_t max_memory;
 } zt_render_options;
 
 /* Defaults: path method, 64 spp, depth 16, all levels, seed 0, all cores. */
 zt_render_options zt_render_options_default(void);
+
+/* Why zt_render returned an image with less than was asked for. */
+typedef enum zt_stop_reason {
+    ZT_STOP_NONE = 0,      /* everything asked for was rendered */
+    ZT_STOP_TIME = 1,      /* options.time_limit */
+    ZT_STOP_INTERRUPT = 2  /* options.stop */
+} zt_stop_reason;
 
 typedef struct zt_render_stats {
     double seconds;        /* wall time of the whole render */
@@ -82,6 +116,13 @@ typedef struct zt_render_stats {
     uint64_t memory_bytes;
     int forest_loaded;     /* zone: the forest came from options.forest_file
                               (phase_one_seconds is then the time to read it) */
+    /* zt_render */
+    int spp_done;          /* path: samples per pixel in the image */
+    int spp_resumed;       /* path: of which read from the checkpoint */
+    int depth_done;        /* the depth the image has (zone: below the
+                              options' when the time ran out) */
+    zt_stop_reason stopped;
+    uint64_t memory_estimate; /* bytes, as checked against max_memory */
 } zt_render_stats;
 
 /* Renders the scene through its camera into a new linear image (*out, the

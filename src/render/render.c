@@ -5,7 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <math.h>
+#include <stdio.h>
+
 #include "geom/accel.h"
+#include "render/memory.h"
 #include "render/render_internal.h"
 #include "util/error.h"
 
@@ -58,6 +62,18 @@ static zt_status check_options(const zt_scene *scene, const zt_render_options *o
                            "cannot switch off light %d: the scene has %d light%s",
                            o->lights_off[i], scene->light_count,
                            scene->light_count == 1 ? "" : "s");
+    if (!(o->time_limit >= 0 && o->time_limit < 1e12))
+        return zt_fail(err, ZT_ERR_ARGUMENT, "the time limit must be a number of seconds >= 0");
+    if (o->time_limit > 0 && o->method == ZT_METHOD_ZONE && o->level >= 0)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "a time limit cannot be kept with a single level: "
+                       "the zone tracer reaches a level only through all before it");
+    if (!(o->checkpoint_seconds >= 0 && o->checkpoint_seconds < 1e12))
+        return zt_fail(err, ZT_ERR_ARGUMENT, "the checkpoint interval must be a number of seconds >= 0");
+    if ((o->checkpoint_file || o->resume) && o->method != ZT_METHOD_PATH)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "checkpoints are for the path tracer (the zone "
+                       "tracer keeps its Phase One in a forest file)");
+    if (o->resume && !o->checkpoint_file)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "resuming needs a checkpoint file");
     if (!scene->has_camera)
         return zt_fail(err, ZT_ERR_ARGUMENT, "the scene has no camera");
     return check_camera(&scene->camera, err);
@@ -74,11 +90,21 @@ void zt_renderer_release(zt_renderer *r)
 }
 
 static zt_status renderer_create(const zt_scene *scene, const zt_render_options *o,
-                                 zt_renderer **out, zt_render_stats *stats,
+                                 double deadline, zt_renderer **out, zt_render_stats *stats,
                                  zt_error *err)
 {
     *out = NULL;
     zt_status st = check_options(scene, o, err);
+    if (st != ZT_OK)
+        return st;
+    uint64_t need = memory_estimate_render(scene, o);
+    if (stats)
+        stats->memory_estimate = need;
+    char what[160];
+    snprintf(what, sizeof what, "this render (a %dx%d image, %d parts, %lld mesh triangles)",
+             scene->camera.width, scene->camera.height, scene->part_count,
+             scene_mesh_triangles(scene));
+    st = memory_check(need, what, o, err);
     if (st != ZT_OK)
         return st;
     zt_renderer *r = calloc(1, sizeof *r);
@@ -87,6 +113,8 @@ static zt_status renderer_create(const zt_scene *scene, const zt_render_options 
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     }
     r->options = *o;
+    r->memory_estimate = need;
+    r->deadline = deadline;
     st = rscene_build(&r->rs, r->scene, o->lights_off, o->lights_off_count,
                       render_accel_kind(r->scene->part_count +
                                         scene_mesh_triangles(r->scene)), err);
@@ -103,7 +131,7 @@ static zt_status renderer_create(const zt_scene *scene, const zt_render_options 
 zt_status zt_renderer_create(const zt_scene *scene, const zt_render_options *o,
                              zt_renderer **out, zt_error *err)
 {
-    return renderer_create(scene, o, out, NULL, err);
+    return renderer_create(scene, o, INFINITY, out, NULL, err);
 }
 
 zt_status zt_renderer_set_camera(zt_renderer *r, const zt_camera *camera,
@@ -147,28 +175,31 @@ zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
     *out = NULL;
     double t0 = render_clock();
     zt_renderer *r;
-    zt_status st = renderer_create(scene, options, &r, stats, err);
+    double deadline = options->time_limit > 0 ? t0 + options->time_limit : INFINITY;
+    zt_status st = renderer_create(scene, options, deadline, &r, stats, err);
     if (st != ZT_OK)
         return st;
-    zt_image *img = zt_image_create(scene->camera.width, scene->camera.height);
-    if (!img) {
-        zt_renderer_release(r);
-        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for a %dx%d image",
-                       scene->camera.width, scene->camera.height);
+    const zt_render_options *o = &r->options; /* the zone tracer's depth may be lower */
+    stats->depth_done = o->level >= 0 ? o->level : o->depth;
+    double prepared = render_clock();
+    zt_image *img = NULL;
+    if (o->method == ZT_METHOD_PATH) {
+        st = path_render_passes(r, t0, &img, stats, err);
+    } else {
+        img = zt_image_create(scene->camera.width, scene->camera.height);
+        st = img ? zt_renderer_accumulate(r, 0, 1, img, stats, err)
+                 : zt_fail(err, ZT_ERR_MEMORY, "out of memory for a %dx%d image",
+                           scene->camera.width, scene->camera.height);
+        if (o->depth < options->depth)
+            stats->stopped = (zt_stop_reason)zone_stop_reason(r);
     }
-    st = zt_renderer_accumulate(r, 0, options->spp, img, stats, err);
     zt_renderer_release(r);
     if (st != ZT_OK) {
         zt_image_release(img);
         return st;
     }
-    if (options->method == ZT_METHOD_PATH) {
-        float inv = 1.0f / (float)options->spp;
-        size_t n = (size_t)img->width * (size_t)img->height * 3;
-        for (size_t i = 0; i < n; i++)
-            img->pixels[i] *= inv;
-    }
     stats->seconds = render_clock() - t0;
+    stats->trace_seconds = render_clock() - prepared;
     *out = img;
     return ZT_OK;
 }

@@ -36,7 +36,34 @@ struct zt_renderer {
     zt_render_options options;
     rscene rs;
     struct zone_forest *forest; /* zone tracer only */
+    double deadline;            /* render_clock() time to be done by
+                                   (INFINITY: no time limit) */
+    uint64_t memory_estimate;   /* bytes: image, scene copy, acceleration
+                                   (render/memory.h); the zone tracer adds
+                                   its forest's */
 };
+
+/* Where path-traced samples go: running sums in double (continued sample
+ * by sample: the same bits however the samples are split into passes), or
+ * added to a float image (the viewer's accumulation). */
+typedef struct path_sums {
+    double *dsum;  /* 3 per pixel, or NULL */
+    float *fsum;   /* used when dsum is NULL */
+    int width, height;
+} path_sums;
+
+/* Adds samples first..first+count-1 of every pixel to out.  shared, when
+ * not NULL, is a progress counting tiles times samples over several calls. */
+zt_status path_accumulate_into(zt_renderer *r, int first, int count, path_sums out,
+                               progress *shared, zt_render_stats *stats, zt_error *err);
+
+/* The tiles of a width x height image (the work units of a pass). */
+int path_tile_count(int width, int height);
+
+/* zt_render's path tracer (passes.c): passes until spp, the time limit or
+ * a stop, with checkpoints; t0 is when zt_render began. */
+zt_status path_render_passes(zt_renderer *r, double t0, zt_image **out,
+                             zt_render_stats *stats, zt_error *err);
 
 /* Adds path-traced samples first..first+count-1 of every pixel to sum. */
 zt_status path_accumulate(zt_renderer *r, int first, int count, zt_image *sum,
@@ -47,6 +74,8 @@ zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err);
 zt_status zone_accumulate(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
                           zt_error *err);
 void zone_release(zt_renderer *r);
+/* Why Phase One built fewer levels than asked (a zt_stop_reason). */
+int zone_stop_reason(const zt_renderer *r);
 
 /* The acceleration structure for a scene of that many primitives: our BVH
  * for small scenes, Embree for large ones, unless ZT_ACCEL in the

@@ -99,6 +99,7 @@ typedef struct zone_forest {
     int loaded;         /* read from a forest file (forest_io.c), not built */
     double build_seconds; /* Phase One time of the build (kept in the file) */
     int images;         /* images rendered from it so far */
+    int stopped;        /* zt_stop_reason: why Phase One built fewer levels */
 } zone_forest;
 
 /* Level l's irradiance at node k. */
@@ -116,7 +117,9 @@ void zone_scene_bounds(const zt_scene *sc, const rscene *rs, vec3 *lo, vec3 *hi)
 
 /* Phase One (phase_one/phase_one.c): the nodes, their irradiance level by
  * level, and the zones. */
-zt_status zone_phase_one(zone_forest *f, const zt_renderer *r, zt_error *err);
+/* When the time limit or an interrupt (r->deadline, options.stop) cuts it
+ * short, the levels built set r->options.depth and f->stopped says why. */
+zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err);
 /* The zones from the irradiance (phase_one/forest.c). */
 zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err);
 /* What the forest holds besides its zones and levels, rebuilt the same on

@@ -46,6 +46,12 @@ zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err)
     return st;
 }
 
+int zone_stop_reason(const zt_renderer *r)
+{
+    const zone_forest *f = (const zone_forest *)r->forest;
+    return f ? f->stopped : ZT_STOP_NONE;
+}
+
 void zone_release(zt_renderer *r)
 {
     zone_forest *f = (zone_forest *)r->forest;

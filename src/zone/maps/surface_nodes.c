@@ -182,7 +182,8 @@ int32_t surface_tri_node(const surface_nodes *sn, const rscene *rs, int prim, in
 }
 
 int surface_nodes_build(surface_nodes *sn, const rscene *rs, const zt_scene *scene, double h,
-                        int max_side, vec3 lo, vec3 hi)
+                        int max_side, vec3 lo, vec3 hi, long long max_nodes,
+                        long long *wanted)
 {
     (void)scene;
     memset(sn, 0, sizeof *sn);
@@ -245,11 +246,12 @@ int surface_nodes_build(surface_nodes *sn, const rscene *rs, const zt_scene *sce
         default:
             continue;
         }
-        np->first = (int32_t)count;
+        np->first = count < INT32_MAX ? (int32_t)count : -1;
         count += (long long)np->count * np->sides;
-        if (count > INT32_MAX - 1)
-            return 0;
     }
+    *wanted = count;
+    if (count > INT32_MAX - 1 || count > max_nodes)
+        return -1;
     sn->node_count = (int)count;
     size_t nc = (size_t)count + 1;
     sn->pos = malloc(nc * 3 * sizeof(float));

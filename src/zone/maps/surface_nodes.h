@@ -80,10 +80,12 @@ typedef struct surface_nodes {
 
 /* Lays out the nodes of every diffuse thing primitive of rs: spacing h,
  * planes' grids over the core [lo, hi] (at most max_side nodes a side over
- * it).  Positions and normals are set, every node live.  Returns 0 when
- * out of memory or past 2^31 nodes. */
+ * it).  Positions and normals are set, every node live.  Returns 1, 0
+ * when out of memory, or -1 when the nodes would be more than max_nodes (or
+ * 2^31): *wanted then says how many, before anything large is allocated. */
 int surface_nodes_build(surface_nodes *sn, const rscene *rs, const zt_scene *scene, double h,
-                        int max_side, vec3 lo, vec3 hi);
+                        int max_side, vec3 lo, vec3 hi, long long max_nodes,
+                        long long *wanted);
 
 void surface_nodes_free(surface_nodes *sn);
 

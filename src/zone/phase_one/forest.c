@@ -1,9 +1,11 @@
 /* The forest around the light: its frame (nodes, occluders, directions,
  * quality), its zones, and what both phases ask of it. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/memory.h"
 #include "render/prim.h"
 #include "scene/mesh.h"
 #include "util/error.h"
@@ -106,7 +108,7 @@ zone_quality zone_quality_for(const zt_scene *sc, const rscene *rs, int q)
     z.sides = 16 << (q / 2);
     z.aa = q < 3 ? 1 : 2;
     z.glint_cuts = 2 << (q / 2);
-    z.photons = 131072 << q;
+    z.photons = 131072 << (q < 12 ? q : 12); /* 2^29 at most: an int */
     z.theta = 0.5 / step;
     /* The cut's error bound: at quality 2 (0.01) the Cornell box's level 2 is
      * 2.4% at 128 x 128 for 0.6 s of Phase One (0.02: 3.2%, 0.45 s; 0.005:
@@ -155,7 +157,28 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
     const rscene *rs = &r->rs;
     vec3 lo, hi;
     zone_scene_bounds(r->scene, rs, &lo, &hi);
-    if (!surface_nodes_build(&f->sn, rs, r->scene, f->q.texel, f->q.max_texels, lo, hi))
+    /* The nodes decide the forest's size: counted first and checked against
+     * the memory limit before anything large is allocated. */
+    const zt_render_options *o = &r->options;
+    int depth = o->level >= 0 ? o->level : o->depth;
+    uint64_t per_node = MEMORY_PER_NODE + (uint64_t)(depth >= 2 ? depth : 0) * MEMORY_PER_NODE_LEVEL;
+    const char *source;
+    uint64_t limit = memory_limit(o->max_memory, &source);
+    uint64_t room = limit > r->memory_estimate ? limit - r->memory_estimate : 0;
+    long long wanted = 0;
+    int built = surface_nodes_build(&f->sn, rs, r->scene, f->q.texel, f->q.max_texels, lo, hi,
+                                    (long long)(room / per_node), &wanted);
+    if (built < 0) {
+        char what[160];
+        snprintf(what, sizeof what, "the zone tracer's forest (%lld surface nodes at quality %d, "
+                 "depth %d) with the rest of the render", wanted, o->quality, depth);
+        if (wanted > INT32_MAX - 1)
+            return zt_fail(err, ZT_ERR_MEMORY, "the zone tracer's forest would have %lld surface "
+                           "nodes at quality %d, more than 2^31: use a lower quality",
+                           wanted, o->quality);
+        return memory_check(r->memory_estimate + (uint64_t)wanted * per_node, what, o, err);
+    }
+    if (!built)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the surfaces' nodes");
     if (!occluders_build(&f->occ, rs))
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the occluder index");

@@ -142,8 +142,8 @@ static int straight(const surface_nodes *sn, const float *v, const int32_t line[
  * stretch is their mean (surface_node_line), else it is computed too.  The
  * rounds depend on nothing but the nodes, so the values are the same on
  * any thread count. */
-static void build_level(zone_forest *f, const zt_renderer *r, int level,
-                        const sender_tree *tree)
+static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
+                             const sender_tree *tree, zt_error *err)
 {
     const rscene *rs = &r->rs;
     const surface_nodes *sn = &f->sn;
@@ -154,7 +154,7 @@ static void build_level(zone_forest *f, const zt_renderer *r, int level,
         tc.floor = 0.02 * 3.14159265358979 * tree->total_power / tree->total_area;
     float *v = calloc(3 * (size_t)sn->node_count + 3, sizeof(float));
     if (!v)
-        return;
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for level %d's node values", level);
     uint64_t rays = 0, links = 0;
     int threads = render_thread_count(r->options.threads);
     for (int pass = 0; pass < NODE_ROUNDS; pass++) {
@@ -188,9 +188,38 @@ static void build_level(zone_forest *f, const zt_renderer *r, int level,
     free(v);
     f->rays += rays;
     f->links += links;
+    return ZT_OK;
 }
 
-zt_status zone_phase_one(zone_forest *f, const zt_renderer *r, zt_error *err)
+/* The time limit and interrupts, between levels.  A level costs about what
+ * the one before did; Phase Two costs about what level 0 did (exact direct
+ * light at every node) per sample point, twice over for its other terms. */
+typedef struct level_clock {
+    double last;        /* seconds of the last level built */
+    double phase_two;   /* estimate */
+} level_clock;
+
+static void level_clock_add(level_clock *lc, const zone_forest *f, const zt_renderer *r,
+                            int level, double seconds)
+{
+    lc->last = seconds;
+    if (level == 0 && f->sn.node_count > 0) {
+        const zt_camera *c = &r->scene->camera;
+        double points = (double)c->width * c->height * f->q.aa * f->q.aa;
+        lc->phase_two = 2.0 * seconds * points / f->sn.node_count;
+    }
+}
+
+static int level_fits(const zone_forest *f, const zt_renderer *r, const level_clock *lc,
+                      double now)
+{
+    (void)f;
+    if (r->options.stop && *r->options.stop)
+        return ZT_STOP_INTERRUPT;
+    return now + lc->last + lc->phase_two > r->deadline ? ZT_STOP_TIME : ZT_STOP_NONE;
+}
+
+zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
 {
     zt_status st = zone_forest_frame(f, r, err);
     if (st != ZT_OK)
@@ -212,12 +241,26 @@ zt_status zone_phase_one(zone_forest *f, const zt_renderer *r, zt_error *err)
         sender_tree tree;
         if (!sender_tree_build(&tree, &f->sn, &r->rs))
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the sender tree");
-        for (int level = 0; level < f->map_levels; level++) {
+        level_clock lc = {0, 0};
+        int built = 0;
+        for (int level = 0; level < f->map_levels && st == ZT_OK; level++) {
+            double t0 = render_clock();
+            if ((f->stopped = level_fits(f, r, &lc, t0)) != ZT_STOP_NONE)
+                break;
             if (level > 0)
                 sender_tree_fill(&tree, &f->sn, &r->rs, zone_e(f, level - 1, 0));
-            build_level(f, r, level, &tree);
+            st = build_level(f, r, level, &tree, err);
+            level_clock_add(&lc, f, r, level, render_clock() - t0);
+            built++;
         }
         sender_tree_free(&tree);
+        if (st != ZT_OK)
+            return st;
+        if (built < f->map_levels) {
+            /* E_0 .. E_{built-1} carry depth `built`; depth 1 needs none. */
+            r->options.depth = built > 1 ? built : 1;
+            f->map_levels = built > 1 ? built : 0;
+        }
     }
     return zone_forest_zones(f, r, err);
 }
