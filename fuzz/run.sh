@@ -7,7 +7,9 @@
 # build-fuzz/fuzz/findings/; after the fix, copy it into
 # fuzz/regressions/HARNESS/ so every test build replays it.
 # usage: fuzz/run.sh [SECONDS] [HARNESS...]
-# ZT_FUZZ_RUNS=N also stops each harness after N executions.
+# ZT_FUZZ_RUNS=N also stops each harness after N executions.  An input that
+# takes more than 30 s (ZT_FUZZ_TIMEOUT) counts as a finding: on a loaded
+# machine libFuzzer's usual 10 s took inputs of under a second for hangs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-1800}
@@ -35,7 +37,7 @@ for h in "${harnesses[@]}"; do
     mkdir -p "$fz/corpus/$h" "$fz/findings"
     log="$fz/$h.log"
     echo "== fuzz_$h for ${seconds}s (log: $log)"
-    if (cd "$fz" && ./fuzz_"$h" -max_total_time="$seconds" -runs="${ZT_FUZZ_RUNS:--1}" -rss_limit_mb=2048 -timeout=10 \
+    if (cd "$fz" && ./fuzz_"$h" -max_total_time="$seconds" -runs="${ZT_FUZZ_RUNS:--1}" -rss_limit_mb=2048 -timeout="${ZT_FUZZ_TIMEOUT:-30}" \
             -print_final_stats=1 -artifact_prefix=findings/"$h"- corpus/"$h" \
             $(for s in "${seeds[@]}"; do printf '%s ' "$OLDPWD/$s"; done)) >"$log" 2>&1; then
         :

@@ -141,9 +141,11 @@ static int straight(const surface_nodes *sn, const float *v, const int32_t line[
  * nodes first; a finer node midway between coarser ones on a straight
  * stretch is their mean (surface_node_line), else it is computed too.  The
  * rounds depend on nothing but the nodes, so the values are the same on
- * any thread count. */
+ * any thread count.  When the clock passes `until` or the render is asked
+ * to stop, the level is abandoned: *abandoned is set and nothing changes. */
 static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
-                             const sender_tree *tree, zt_error *err)
+                             const sender_tree *tree, double until, int *abandoned,
+                             zt_error *err)
 {
     const rscene *rs = &r->rs;
     const surface_nodes *sn = &f->sn;
@@ -157,11 +159,21 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for level %d's node values", level);
     uint64_t rays = 0, links = 0;
     int threads = render_thread_count(r->options.threads);
-    for (int pass = 0; pass < NODE_ROUNDS; pass++) {
+    const volatile sig_atomic_t *stop = r->options.stop;
+    int quit = 0;
+    for (int pass = 0; pass < NODE_ROUNDS && !quit; pass++) {
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads) reduction(+ : rays, links)
         for (int k = 0; k < sn->node_count; k++) {
-            if (!sn->live[k])
+            int q;
+#pragma omp atomic read
+            q = quit;
+            if (q || !sn->live[k])
                 continue;
+            if (k % 64 == 0 && (render_clock() > until || (stop && *stop))) {
+#pragma omp atomic write
+                quit = 1;
+                continue;
+            }
             int32_t line[4];
             double pos[5], w = 0.5;
             int fine = surface_node_line(sn, rs, k, line, pos);
@@ -180,43 +192,32 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
             v[3 * (size_t)k + 2] = (float)e.z;
         }
     }
-    for (int k = 0; k < sn->node_count; k++) {
-        float *px = zone_e(f, level, k);
-        for (int ch = 0; ch < 3; ch++)
-            px[ch] += v[3 * (size_t)k + ch];
-    }
-    free(v);
     f->rays += rays;
+    *abandoned = quit;
+    if (!quit)
+        for (int k = 0; k < sn->node_count; k++) {
+            float *px = zone_e(f, level, k);
+            for (int ch = 0; ch < 3; ch++)
+                px[ch] += v[3 * (size_t)k + ch];
+        }
+    free(v);
     f->links += links;
     return ZT_OK;
 }
 
-/* The time limit and interrupts, between levels.  A level costs about what
- * the one before did; Phase Two costs about what level 0 did (exact direct
- * light at every node) per sample point, twice over for its other terms. */
-typedef struct level_clock {
-    double last;        /* seconds of the last level built */
-    double phase_two;   /* estimate */
-} level_clock;
+/* The time limit: Phase Two must fit after the last level.  It costs about
+ * what level 0 did (exact direct light at every node) per sample point,
+ * times PHASE_TWO_FACTOR for its other terms (measured 3.9-6.7 on the Cornell
+ * box at qualities 2 and 4). */
+#define PHASE_TWO_FACTOR 6.0
 
-static void level_clock_add(level_clock *lc, const zone_forest *f, const zt_renderer *r,
-                            int level, double seconds)
+static double phase_two_estimate(const zone_forest *f, const zt_renderer *r, double level0)
 {
-    lc->last = seconds;
-    if (level == 0 && f->sn.node_count > 0) {
-        const zt_camera *c = &r->scene->camera;
-        double points = (double)c->width * c->height * f->q.aa * f->q.aa;
-        lc->phase_two = 2.0 * seconds * points / f->sn.node_count;
-    }
-}
-
-static int level_fits(const zone_forest *f, const zt_renderer *r, const level_clock *lc,
-                      double now)
-{
-    (void)f;
-    if (r->options.stop && *r->options.stop)
-        return ZT_STOP_INTERRUPT;
-    return now + lc->last + lc->phase_two > r->deadline ? ZT_STOP_TIME : ZT_STOP_NONE;
+    if (f->sn.node_count <= 0)
+        return 0;
+    const zt_camera *c = &r->scene->camera;
+    double points = (double)c->width * c->height * f->q.aa * f->q.aa;
+    return PHASE_TWO_FACTOR * level0 * points / f->sn.node_count;
 }
 
 zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
@@ -241,16 +242,25 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
         sender_tree tree;
         if (!sender_tree_build(&tree, &f->sn, &r->rs))
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the sender tree");
-        level_clock lc = {0, 0};
+        /* Levels are built while they fit before the deadline, less the
+         * time Phase Two will need; one that does not is abandoned. */
+        double phase_two = 0;
         int built = 0;
         for (int level = 0; level < f->map_levels && st == ZT_OK; level++) {
             double t0 = render_clock();
-            if ((f->stopped = level_fits(f, r, &lc, t0)) != ZT_STOP_NONE)
-                break;
             if (level > 0)
                 sender_tree_fill(&tree, &f->sn, &r->rs, zone_e(f, level - 1, 0));
-            st = build_level(f, r, level, &tree, err);
-            level_clock_add(&lc, f, r, level, render_clock() - t0);
+            int abandoned = 0;
+            st = build_level(f, r, level, &tree, r->deadline - phase_two, &abandoned, err);
+            if (st != ZT_OK)
+                break;
+            if (abandoned) {
+                f->stopped = r->options.stop && *r->options.stop ? ZT_STOP_INTERRUPT
+                                                                 : ZT_STOP_TIME;
+                break;
+            }
+            if (level == 0)
+                phase_two = phase_two_estimate(f, r, render_clock() - t0);
             built++;
         }
         sender_tree_free(&tree);
