@@ -1030,7 +1030,7 @@ int cli_view(int argc, char **argv)
     viewer *v = calloc(1, sizeof *v);
     if (!v) {
         cli_error("out of memory");
-        return EXIT_FAILURE_OTHER;
+        return EXIT_MEMORY;
     }
     v->fps = 10;
     v->move_step = 1.0;
@@ -1106,6 +1106,7 @@ int cli_view(int argc, char **argv)
             code = v->exit_code;
             pthread_mutex_lock(&v->sh.lock);
             atomic_store(&v->sh.quit, 1);
+            v->sh.stop_build = 1;
             pthread_cond_broadcast(&v->sh.wake);
             pthread_mutex_unlock(&v->sh.lock);
             view_worker_join(&v->worker);

@@ -177,6 +177,7 @@ static zt_render_options make_options(wstate *s, const view_request *req, int me
     o.lights_off_count = req->lights_off_count;
     o.progress = cancel_check;
     o.progress_user = s;
+    o.stop = &s->w->shared->stop_build;
     return o;
 }
 

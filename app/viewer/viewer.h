@@ -121,6 +121,9 @@ typedef struct view_shared {
     view_request req;
     atomic_uint_least64_t cam_epoch, opt_epoch; /* bumped on changes */
     atomic_int quit;
+    /* Raised with quit: a zone tracer Phase One under way gives up its
+     * level (options.stop) instead of holding the window open. */
+    volatile sig_atomic_t stop_build;
     view_frame front;        /* the last published frame */
     /* messages from the worker to the main thread (a method fallback...) */
     char message[VIEW_MESSAGE_MAX];
