@@ -124,7 +124,8 @@ int cli_animate(const char *scene_path, const zt_render_options *options,
      * not match its neighbours) and starts no other. */
     zt_render_options opt = *options;
     opt.stop = NULL;
-    cli_interrupts_install();
+    cli_interrupts_install("\nzonetrace: finishing the current frame, then stopping "
+                           "(interrupt again to abort it)\n");
     double total_seconds = 0;
     uint64_t total_rays = 0;
     int frames_done = 0;

@@ -22,10 +22,11 @@ enum {
 };
 
 /* Interrupts (interrupt.c).  After cli_interrupts_install, the first SIGINT
- * or SIGTERM sets cli_stop (renders finish their pass and write what they
- * have); the second ends the process at once with 128 + its number. */
+ * or SIGTERM sets cli_stop and prints message (renders finish their pass
+ * and write what they have); the second ends the process at once with
+ * 128 + its number. */
 extern volatile sig_atomic_t cli_stop;
-void cli_interrupts_install(void);
+void cli_interrupts_install(const char *message);
 
 
 

@@ -8,6 +8,8 @@
 #include "cli.h"
 
 volatile sig_atomic_t cli_stop = 0;
+static const char *notice;
+static size_t notice_length;
 
 static void on_signal(int sig)
 {
@@ -18,14 +20,14 @@ static void on_signal(int sig)
         _exit(128 + sig);
     }
     cli_stop = 1;
-    static const char msg[] = "\nzonetrace: stopping after the current pass (interrupt again "
-                              "to abort with nothing written)\n";
-    ssize_t ignored = write(2, msg, sizeof msg - 1);
+    ssize_t ignored = write(2, notice, notice_length);
     (void)ignored;
 }
 
-void cli_interrupts_install(void)
+void cli_interrupts_install(const char *message)
 {
+    notice = message;
+    notice_length = strlen(message);
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;

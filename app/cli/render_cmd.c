@@ -377,7 +377,11 @@ int cli_render(int argc, char **argv)
     }
     zt_image *img = NULL;
     zt_render_stats stats;
-    cli_interrupts_install();
+    cli_interrupts_install(opt.method == ZT_METHOD_PATH
+                               ? "\nzonetrace: stopping after the current pass (interrupt "
+                                 "again to abort with nothing written)\n"
+                               : "\nzonetrace: building no further level, then rendering "
+                                 "(interrupt again to abort with nothing written)\n");
     opt.stop = &cli_stop;
     if (time_limit > 0)
         opt.time_limit = cli_time_left(time_limit, (long long)zt_scene_get_camera(scene).width *
