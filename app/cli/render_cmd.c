@@ -419,6 +419,9 @@ int cli_render(int argc, char **argv)
     }
     if (verbose && opt.method == ZT_METHOD_ZONE)
         print_zone_stats(&stats, opt.forest_file);
+    if (verbose)
+        fprintf(stderr, "memory: %.1f MiB estimated before the work (docs/long-renders.md)\n",
+                stats.memory_estimate / 1048576.0);
     cli_report_stop(&opt, &stats, quiet);
     return stats.stopped == ZT_STOP_INTERRUPT ? EXIT_INTERRUPTED : EXIT_OK;
 }

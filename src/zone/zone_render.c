@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/memory.h"
 #include "util/error.h"
 #include "zone/io/forest_io.h"
 #include "zone/phase_two/phase_two.h"
@@ -42,6 +43,9 @@ zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err)
     if (stats) {
         stats->phase_one_seconds = f->phase_one_seconds;
         fill_forest_stats(f, stats);
+        stats->memory_estimate = r->memory_estimate +
+                                 (uint64_t)f->sn.node_count *
+                                     (MEMORY_PER_NODE + MEMORY_PER_NODE_LEVEL * (uint64_t)f->map_levels);
     }
     return st;
 }
