@@ -413,6 +413,40 @@ static void test_cli_interrupts(void **state)
     free(b);
 }
 
+/* The options' misuse, and the refusals, as exit codes and messages. */
+static void expect_cli(const char *args, int code, const char *needle)
+{
+    char cmd[2048], *err = NULL;
+    snprintf(cmd, sizeof cmd, "render '%s' -o '%s' %s", ZT_SOURCE_DIR "/scenes/cornell.json",
+             test_tmp_path("opts.png"), args);
+    int got = test_run_cli(cmd, &err);
+    if (got != code || !err || !strstr(err, needle))
+        fprintf(stderr, "%s: exit %d (wanted %d): %s\n", args, got, code, err ? err : "");
+    assert_int_equal(got, code);
+    assert_non_null(strstr(err, needle));
+    free(err);
+}
+
+static void test_cli_options(void **state)
+{
+    (void)state;
+    expect_cli("--method zone --checkpoint c.ckpt", 1, "for the path tracer");
+    expect_cli("--resume a.ckpt --checkpoint b.ckpt", 1, "cannot name another file");
+    expect_cli("--method zone --level 2 --time-limit 5", 1, "--level");
+    expect_cli("--method zone --time-limit 5 --save-forest f.ztf", 1, "saved whole");
+    expect_cli("--time-limit 0", 1, "--time-limit");
+    expect_cli("--max-memory 12abc", 1, "--max-memory");
+    expect_cli("--checkpoint /nonexistent-dir/c.ckpt", 1, "not writable");
+    expect_cli("--resume /nonexistent-dir/c.ckpt", 1, "not writable");
+    expect_cli("--size 100000x100000", 1, "335 GiB");
+    expect_cli("--size 2000x2000 --max-memory 100M", 5, "183.1 MiB");
+    expect_cli("--method zone --quality 16 --max-memory 8G", 5, "surface nodes");
+    char args[1024];
+    snprintf(args, sizeof args, "--size 8x8 --resume '%s'", test_tmp_path("absent.ckpt"));
+    expect_cli(args, 2, "cannot open checkpoint");
+    expect_cli("--size 8x8 --spp 1000000 --time-limit 0.2", 0, "stopped by the time limit");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -421,6 +455,7 @@ int main(void)
         cmocka_unit_test(test_time_limits),
         cmocka_unit_test(test_memory_limits),
         cmocka_unit_test(test_cli_interrupts),
+        cmocka_unit_test(test_cli_options),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

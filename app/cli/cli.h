@@ -70,6 +70,11 @@ int cli_progress_callback(void *user, const char *stage, double done, double tot
 void cli_progress_finish(cli_progress *p);
 double cli_now(void);
 
+/* Whether path can be written (the library writes beside it and renames):
+ * not a directory, and its directory takes new files.  Otherwise says why,
+ * naming it "cannot write WHAT'path'", and returns 0. */
+int cli_can_replace(const char *path, const char *what);
+
 /* When the process started (cli_now), for --time-limit. */
 extern double cli_start;
 

@@ -3,29 +3,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "cli.h"
-
-/* The checkpoint's directory must take new files (written beside it and
- * renamed over it), found out now rather than at the first checkpoint. */
-static int checkpoint_dir_writable(const char *path)
-{
-    char dir[4096];
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        strcpy(dir, ".");
-    else if (slash == path)
-        strcpy(dir, "/");
-    else
-        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
-    if (access(dir, W_OK | X_OK) != 0) {
-        cli_error("cannot write checkpoint '%s': directory '%s' is missing or not writable",
-                  path, dir);
-        return 0;
-    }
-    return 1;
-}
 
 int long_render_options(zt_render_options *opt, const char *checkpoint, const char *resume,
                         double time_limit, unsigned long long max_memory,
@@ -48,7 +27,8 @@ int long_render_options(zt_render_options *opt, const char *checkpoint, const ch
         }
         opt->checkpoint_file = resume ? resume : checkpoint;
         opt->resume = resume != NULL;
-        if (!checkpoint_dir_writable(opt->checkpoint_file))
+        /* Found out now rather than at the first checkpoint. */
+        if (!cli_can_replace(opt->checkpoint_file, "checkpoint "))
             return EXIT_USAGE;
     }
     if (time_limit > 0) {

@@ -146,24 +146,7 @@ static int output_writable(const char *path)
         cli_error("cannot tell the image format of '%s': use .png, .ppm, .pfm or .exr", path);
         return -1;
     }
-    struct stat st;
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        cli_error("cannot write '%s': it is a directory", path);
-        return 0;
-    }
-    char dir[4096];
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        strcpy(dir, ".");
-    else if (slash == path)
-        strcpy(dir, "/");
-    else
-        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
-    if (access(dir, W_OK | X_OK) != 0) {
-        cli_error("cannot write '%s': directory '%s' is missing or not writable", path, dir);
-        return 0;
-    }
-    return 1;
+    return cli_can_replace(path, "");
 }
 
 /* The zone tracer's forest figures and phase times (-v). */
