@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-1800}
 shift || true
 harnesses=("$@")
-[ ${#harnesses[@]} -gt 0 ] || harnesses=(scene motions image forest)
+[ ${#harnesses[@]} -gt 0 ] || harnesses=(scene motions image forest checkpoint)
 
 CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DZT_FUZZ=ON \
     -DZT_BUILD_BENCH=OFF -DZT_WITH_VIEWER=OFF >/dev/null
@@ -30,8 +30,8 @@ for h in "${harnesses[@]}"; do
     case $h in
     scene) seeds=(scenes fuzz/seeds/scene); [ -d ../shared/scenes ] && seeds+=(../shared/scenes) ;;
     motions) seeds=(fuzz/seeds/motions) ;;
-    image|forest) seeds=("$fz/seeds/$h") ;;
-    *) echo "run.sh: no harness '$h' (scene, motions, image, forest)" >&2; exit 1 ;;
+    image|forest|checkpoint) seeds=("$fz/seeds/$h") ;;
+    *) echo "run.sh: no harness '$h' (scene, motions, image, forest, checkpoint)" >&2; exit 1 ;;
     esac
     [ -d "fuzz/regressions/$h" ] && seeds+=("fuzz/regressions/$h")
     mkdir -p "$fz/corpus/$h" "$fz/findings"
