@@ -84,7 +84,7 @@ zt_status path_render_passes(zt_renderer *r, double t0, zt_image **out,
             break;
         double after = render_clock();
         done += count;
-        per_sample = (after - now) / count;
+        per_sample = fmax((after - now) / count, 1e-9); /* > 0: measured */
         stats->rays += ps.rays;
         stats->samples += ps.samples;
         stats->threads = ps.threads;
