@@ -16,4 +16,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
  * cannot write its input tests nothing. */
 const char *fuzz_scratch_file(const uint8_t *data, size_t size, const char *suffix);
 
+/* fuzz/forest_scene.json, loaded once (aborts when it does not load). */
+struct zt_scene;
+struct zt_scene *fuzz_small_scene(void);
+
 #endif

@@ -8,24 +8,9 @@
 #include "zonetrace/render.h"
 #include "zonetrace/scene.h"
 
-#ifndef ZT_SOURCE_DIR
-#error "ZT_SOURCE_DIR must name the source tree"
-#endif
-
-static zt_scene *base_scene(void)
-{
-    static zt_scene *scene;
-    if (!scene) {
-        zt_error err;
-        if (zt_scene_load_file(ZT_SOURCE_DIR "/fuzz/forest_scene.json", &scene, &err) != ZT_OK)
-            abort();
-    }
-    return scene;
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    zt_scene *scene = base_scene();
+    zt_scene *scene = fuzz_small_scene();
     zt_render_options o = zt_render_options_default();
     o.method = ZT_METHOD_ZONE;
     o.depth = 2;

@@ -1,10 +1,16 @@
-/* Scratch files for harnesses whose readers take a path. */
+/* Scratch files for harnesses whose readers take a path, and the small
+ * scene the forest and checkpoint harnesses render. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
 
 #include "fuzz.h"
+#include "zonetrace/scene.h"
+
+#ifndef ZT_SOURCE_DIR
+#error "ZT_SOURCE_DIR must name the source tree"
+#endif
 
 static char scratch[256];
 
@@ -28,4 +34,15 @@ const char *fuzz_scratch_file(const uint8_t *data, size_t size, const char *suff
         abort();
     }
     return scratch;
+}
+
+zt_scene *fuzz_small_scene(void)
+{
+    static zt_scene *scene;
+    if (!scene) {
+        zt_error err;
+        if (zt_scene_load_file(ZT_SOURCE_DIR "/fuzz/forest_scene.json", &scene, &err) != ZT_OK)
+            abort();
+    }
+    return scene;
 }
