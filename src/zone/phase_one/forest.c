@@ -1,5 +1,6 @@
 /* The forest around the light: its frame (nodes, occluders, directions,
  * quality), its zones, and what both phases ask of it. */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -166,8 +167,9 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
     uint64_t limit = memory_limit(o->max_memory, &source);
     uint64_t room = limit > r->memory_estimate ? limit - r->memory_estimate : 0;
     long long wanted = 0;
+    uint64_t fit = room / per_node;
     int built = surface_nodes_build(&f->sn, rs, r->scene, f->q.texel, f->q.max_texels, lo, hi,
-                                    (long long)(room / per_node), &wanted);
+                                    fit > (uint64_t)LLONG_MAX ? LLONG_MAX : (long long)fit, &wanted);
     if (built < 0) {
         char what[160];
         snprintf(what, sizeof what, "the zone tracer's forest (%lld surface nodes at quality %d, "
