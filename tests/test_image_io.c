@@ -42,13 +42,6 @@ static zt_image *make_hdr_image(int width, int height)
     return image;
 }
 
-static void assert_same_bits(const zt_image *a, const zt_image *b)
-{
-    assert_int_equal(a->width, b->width);
-    assert_int_equal(a->height, b->height);
-    assert_memory_equal(a->pixels, b->pixels, (size_t)a->width * a->height * 3 * sizeof(float));
-}
-
 static int count_temporaries(const char *dir)
 {
     DIR *d = opendir(dir);
@@ -123,7 +116,7 @@ static void round_trip_hdr(const char *name, int width, int height)
     zt_image *back = NULL;
     assert_int_equal(zt_image_read(path, &back, &err), ZT_OK);
     assert_non_null(back);
-    assert_same_bits(image, back);
+    test_assert_same_image(image, back, "read back");
     zt_image_release(image);
     zt_image_release(back);
 }
@@ -872,7 +865,7 @@ static void test_failed_write_keeps_target(void **state)
     assert_int_equal(zt_image_write(image, join(dir, "keep.pfm"), NULL, &err), ZT_OK);
     zt_image *back = NULL;
     assert_int_equal(zt_image_read(join(dir, "keep.pfm"), &back, &err), ZT_OK);
-    assert_same_bits(image, back);
+    test_assert_same_image(image, back, "read back");
     assert_int_equal(count_temporaries(dir), 0);
     zt_image_release(back);
     zt_image_release(image);

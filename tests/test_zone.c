@@ -104,18 +104,6 @@ static zt_image *accumulate(zt_renderer *r, const zt_scene *s, zt_render_stats *
 
 static size_t floats(const zt_image *a) { return (size_t)a->width * a->height * 3; }
 
-static void assert_same_bytes(const zt_image *a, const zt_image *b, const char *what)
-{
-    assert_int_equal(a->width, b->width);
-    assert_int_equal(a->height, b->height);
-    if (memcmp(a->pixels, b->pixels, floats(a) * sizeof(float)) != 0) {
-        for (size_t i = 0; i < floats(a); i++)
-            if (memcmp(&a->pixels[i], &b->pixels[i], sizeof(float)) != 0)
-                fail_msg("%s: float %zu differs: %.9g vs %.9g", what, i, a->pixels[i],
-                         b->pixels[i]);
-    }
-}
-
 /* sqrt(mean((a-b)^2)) / mean(b), as `zonetrace compare` computes it. */
 static double rel_rmse(const zt_image *a, const zt_image *b)
 {
@@ -146,8 +134,8 @@ static void test_deterministic(void **state)
     zt_render_options o1 = zone_options(2, 1), o2 = zone_options(2, 2);
     zt_image *a = render(s, &o2, NULL), *b = render(s, &o2, NULL), *c = render(s, &o1, NULL);
     assert_true(image_mean(a) > 0);
-    assert_same_bytes(a, b, "two runs");
-    assert_same_bytes(a, c, "1 vs 2 threads");
+    test_assert_same_image(a, b, "two runs");
+    test_assert_same_image(a, c, "1 vs 2 threads");
     zt_image_release(a);
     zt_image_release(b);
     zt_image_release(c);
@@ -169,9 +157,9 @@ static void check_strategies(const char *text, int depth, int level)
         img[i] = accumulate(r, s, NULL);
     }
     assert_true(image_mean(img[0]) > 0);
-    assert_same_bytes(img[0], img[1], "pixel strategy, 1 vs 2 threads");
-    assert_same_bytes(img[0], img[2], "pixel vs zone strategy");
-    assert_same_bytes(img[0], img[3], "pixel vs zone strategy, 2 threads");
+    test_assert_same_image(img[0], img[1], "pixel strategy, 1 vs 2 threads");
+    test_assert_same_image(img[0], img[2], "pixel vs zone strategy");
+    test_assert_same_image(img[0], img[3], "pixel vs zone strategy, 2 threads");
     for (int i = 0; i < 4; i++)
         zt_image_release(img[i]);
     zt_renderer_release(r);
@@ -273,7 +261,7 @@ static void test_crossings(void **state)
     zt_render_options lo = o;
     lo.forest_file = path;
     zt_image *loaded = render(s, &lo, NULL);
-    assert_same_bytes(all, loaded, "crossings: built vs loaded forest");
+    test_assert_same_image(all, loaded, "crossings: built vs loaded forest");
     zt_image_release(loaded);
     assert_levels_sum(s, o, all, 0, "crossings: levels");
     zt_image_release(all);
@@ -330,7 +318,7 @@ static void test_forest_round_trip(void **state)
         lo.threads = 1 + strategy;
         zt_render_stats stats;
         zt_image *loaded = render(s, &lo, &stats);
-        assert_same_bytes(built, loaded, "built vs loaded forest");
+        test_assert_same_image(built, loaded, "built vs loaded forest");
         assert_int_equal(stats.forest_loaded, 1);
         assert_int_equal(stats.zones, built_stats.zones);
         assert_int_equal(stats.zones_pruned, built_stats.zones_pruned);
@@ -345,14 +333,7 @@ static void test_forest_round_trip(void **state)
     zt_renderer *r2 = renderer(s, &lo);
     const char *path2 = test_tmp_path("box2.forest");
     assert_int_equal(zt_renderer_save_forest(r2, path2, &err), ZT_OK);
-    size_t n1, n2;
-    char *f1 = test_read_file(path, &n1), *f2 = test_read_file(path2, &n2);
-    assert_non_null(f1);
-    assert_non_null(f2);
-    assert_int_equal(n1, n2);
-    assert_memory_equal(f1, f2, n1);
-    free(f1);
-    free(f2);
+    test_assert_same_file(path, path2);
     zt_renderer_release(r2);
 
     /* A path-tracing renderer has no forest. */
@@ -388,7 +369,7 @@ static void test_forest_round_trip_seams(void **state)
     zt_render_stats stats;
     zt_image *loaded = render(s, &o, &stats);
     assert_int_equal(stats.forest_loaded, 1);
-    assert_same_bytes(built, loaded, "Cornell box: built vs loaded forest");
+    test_assert_same_image(built, loaded, "Cornell box: built vs loaded forest");
     zt_image_release(built);
     zt_image_release(loaded);
     zt_renderer_release(r);
@@ -512,7 +493,7 @@ static void test_camera_moves_without_phase_one(void **state)
     o.strategy = ZT_STRATEGY_ZONE;
     zt_renderer *r2 = renderer(s, &o);
     zt_image *c = accumulate(r2, s, NULL);
-    assert_same_bytes(b, c, "moved camera: kept vs loaded forest");
+    test_assert_same_image(b, c, "moved camera: kept vs loaded forest");
     zt_image_release(a);
     zt_image_release(b);
     zt_image_release(c);

@@ -28,8 +28,6 @@ enum {
 extern volatile sig_atomic_t cli_stop;
 void cli_interrupts_install(const char *message);
 
-
-
 /* The exit code for a library status. */
 int cli_exit_code(zt_status status);
 

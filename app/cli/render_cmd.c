@@ -366,9 +366,10 @@ int cli_render(int argc, char **argv)
                                : "\nzonetrace: building no further level, then rendering "
                                  "(interrupt again to abort with nothing written)\n");
     opt.stop = &cli_stop;
-    if (time_limit > 0)
-        opt.time_limit = cli_time_left(time_limit, (long long)zt_scene_get_camera(scene).width *
-                                                        zt_scene_get_camera(scene).height);
+    if (time_limit > 0) {
+        zt_camera cam = zt_scene_get_camera(scene);
+        opt.time_limit = cli_time_left(time_limit, (long long)cam.width * cam.height);
+    }
     st = forest_out ? render_saving_forest(scene, &opt, forest_out, &img, &stats, &err)
                     : zt_render(scene, &opt, &img, &stats, &err);
     cli_progress_finish(&prog);

@@ -17,18 +17,13 @@
 #include <string.h>
 
 #include "image/atomic_file.h"
+#include "render/render_internal.h"
 #include "scene/scene_hash.h"
 #include "util/error.h"
 #include "util/fnv1a.h"
 
 static const char MAGIC[8] = {'Z', 'T', 'C', 'H', 'E', 'C', 'K', '1'};
 #define HEADER_BYTES 32
-
-static int cmp_int(const void *a, const void *b)
-{
-    int x = *(const int *)a, y = *(const int *)b;
-    return (x > y) - (x < y);
-}
 
 uint64_t checkpoint_key(const zt_scene *scene, const zt_render_options *o)
 {
@@ -45,12 +40,9 @@ uint64_t checkpoint_key(const zt_scene *scene, const zt_render_options *o)
     fnv_u64(&h, o->seed);
     fnv_i32(&h, o->level >= 0 ? o->level : 0);
     fnv_i32(&h, o->level >= 0 ? o->level : o->depth);
-    int n = o->lights_off_count, off[ZT_MAX_LIGHTS_OFF];
-    memcpy(off, o->lights_off, (size_t)n * sizeof *off);
-    qsort(off, (size_t)n, sizeof *off, cmp_int);
+    int off[ZT_MAX_LIGHTS_OFF], n = render_lights_off_sorted(o, off);
     for (int i = 0; i < n; i++)
-        if (i == 0 || off[i] != off[i - 1])
-            fnv_i32(&h, off[i]);
+        fnv_i32(&h, off[i]);
     return h.h;
 }
 
@@ -158,7 +150,7 @@ zt_status checkpoint_read(const char *path, uint64_t key, int width, int height,
     }
     if (s < 1 || s > (uint32_t)max_samples) {
         st = zt_fail(err, ZT_ERR_PARSE, "checkpoint '%s' holds %u samples per pixel, more than "
-                     "the %d asked for (--spp)", path, s, max_samples);
+                     "the %d asked for", path, s, max_samples);
         goto done;
     }
     fnv1a h = {FNV1A_START};

@@ -52,6 +52,11 @@ uint64_t memory_estimate_render(const zt_scene *sc, const zt_render_options *o)
            (uint64_t)sc->part_count * PER_PART;
 }
 
+uint64_t memory_zone_nodes(long long nodes, int map_levels)
+{
+    return (uint64_t)nodes * (600 + 12 * (uint64_t)map_levels);
+}
+
 const char *memory_format(uint64_t bytes, char *buf, int size)
 {
     static const char *unit[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB"};

@@ -9,11 +9,12 @@
 #include "zonetrace/render.h"
 #include "scene/scene.h"
 
-/* Bytes per zone tracer surface node during Phase One (node arrays, sender
- * tree, node life, transfer), and per node and level (the maps); measured
- * on the Cornell box at qualities 2-6 and on the engine room (490-520 B). */
-#define MEMORY_PER_NODE 600
-#define MEMORY_PER_NODE_LEVEL 12
+/* Bytes the zone tracer's forest takes during Phase One for that many
+ * surface nodes with irradiance maps of map_levels levels: 600 a node (node
+ * arrays, sender tree, node life, transfer) and 12 a node and level (the
+ * maps); measured on the Cornell box at qualities 2-6 and on the engine
+ * room (475-520 bytes a node). */
+uint64_t memory_zone_nodes(long long nodes, int map_levels);
 
 /* The limit: requested when not 0, else the machine's physical memory or
  * the control group's limit, whichever is lower.  *source says which

@@ -2,11 +2,10 @@
  * and the dispatch to the path or zone tracer. */
 #include "zonetrace/render.h"
 
-#include <stdlib.h>
-#include <string.h>
-
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "geom/accel.h"
 #include "render/memory.h"

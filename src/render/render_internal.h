@@ -9,6 +9,12 @@
 /* Wall-clock seconds from an arbitrary origin. */
 double render_clock(void);
 
+/* The lights switched off in o, ascending and without repeats, into out;
+ * returns their count.  Files made for one render (forest files,
+ * checkpoints) record this form, so the order they were given in does not
+ * matter. */
+int render_lights_off_sorted(const zt_render_options *o, int out[ZT_MAX_LIGHTS_OFF]);
+
 /* The number of threads to use for a requested count (0 = all cores). */
 int render_thread_count(int requested);
 

@@ -15,6 +15,24 @@ double render_clock(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+static int cmp_int(const void *a, const void *b)
+{
+    int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+int render_lights_off_sorted(const zt_render_options *o, int out[ZT_MAX_LIGHTS_OFF])
+{
+    int n = o->lights_off_count < ZT_MAX_LIGHTS_OFF ? o->lights_off_count : ZT_MAX_LIGHTS_OFF;
+    int tmp[ZT_MAX_LIGHTS_OFF], count = 0;
+    memcpy(tmp, o->lights_off, (size_t)n * sizeof *tmp);
+    qsort(tmp, (size_t)n, sizeof *tmp, cmp_int);
+    for (int i = 0; i < n; i++)
+        if (i == 0 || tmp[i] != tmp[i - 1])
+            out[count++] = tmp[i];
+    return count;
+}
+
 int render_thread_count(int requested)
 {
     return requested > 0 ? requested : omp_get_num_procs();

@@ -44,8 +44,7 @@ zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err)
         stats->phase_one_seconds = f->phase_one_seconds;
         fill_forest_stats(f, stats);
         stats->memory_estimate = r->memory_estimate +
-                                 (uint64_t)f->sn.node_count *
-                                     (MEMORY_PER_NODE + MEMORY_PER_NODE_LEVEL * (uint64_t)f->map_levels);
+                                 memory_zone_nodes(f->sn.node_count, f->map_levels);
     }
     return st;
 }

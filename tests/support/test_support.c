@@ -121,3 +121,27 @@ zt_renderer *test_zone_renderer(const zt_scene *s, int depth, int threads, int q
         fail_msg("zone renderer: %s", err.message);
     return r;
 }
+
+void test_assert_same_image(const zt_image *a, const zt_image *b, const char *what)
+{
+    assert_int_equal(a->width, b->width);
+    assert_int_equal(a->height, b->height);
+    size_t n = (size_t)a->width * a->height * 3;
+    if (memcmp(a->pixels, b->pixels, n * sizeof(float)) != 0)
+        for (size_t i = 0; i < n; i++)
+            if (memcmp(&a->pixels[i], &b->pixels[i], sizeof(float)) != 0)
+                fail_msg("%s: float %zu differs: %.9g vs %.9g", what, i, a->pixels[i],
+                         b->pixels[i]);
+}
+
+void test_assert_same_file(const char *a, const char *b)
+{
+    size_t la = 0, lb = 0;
+    char *da = test_read_file(a, &la), *db = test_read_file(b, &lb);
+    assert_non_null(da);
+    assert_non_null(db);
+    assert_int_equal(la, lb);
+    assert_memory_equal(da, db, la);
+    free(da);
+    free(db);
+}

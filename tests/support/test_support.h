@@ -38,6 +38,13 @@ const char *test_write_file(const char *name, const char *text);
  * returning the exit status (or -1 if it died from a signal). */
 int test_run_cli(const char *args, char **err_out);
 
+/* Fails the test unless a and b have the same size and the same float
+ * bits, naming `what` and the first float that differs. */
+void test_assert_same_image(const zt_image *a, const zt_image *b, const char *what);
+
+/* Fails the test unless the two files exist and hold the same bytes. */
+void test_assert_same_file(const char *a, const char *b);
+
 /* Reads a whole file (malloc'd, NUL-terminated) or NULL. */
 char *test_read_file(const char *path, size_t *length);
 

@@ -33,25 +33,13 @@ typedef struct forest_options {
     double texel_divisor, theta, eps;
 } forest_options;
 
-static int cmp_int(const void *a, const void *b)
-{
-    int x = *(const int *)a, y = *(const int *)b;
-    return (x > y) - (x < y);
-}
-
 static void options_of(const zt_render_options *o, const zone_quality *q, forest_options *fo)
 {
     memset(fo, 0, sizeof *fo);
     fo->depth = o->level >= 0 ? o->level : o->depth;
     fo->quality = o->quality;
     fo->cutoff = o->cutoff;
-    int n = o->lights_off_count < ZT_MAX_LIGHTS_OFF ? o->lights_off_count : ZT_MAX_LIGHTS_OFF;
-    int tmp[ZT_MAX_LIGHTS_OFF];
-    memcpy(tmp, o->lights_off, (size_t)n * sizeof *tmp);
-    qsort(tmp, (size_t)n, sizeof *tmp, cmp_int);
-    for (int i = 0; i < n; i++)
-        if (i == 0 || tmp[i] != tmp[i - 1])
-            fo->lights_off[fo->lights_off_count++] = tmp[i];
+    fo->lights_off_count = render_lights_off_sorted(o, fo->lights_off);
     fo->gather = q->gather;
     fo->sides = q->sides;
     fo->aa = q->aa;

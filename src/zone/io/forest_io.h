@@ -23,7 +23,6 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
 zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *expect,
                       const char *path, zt_error *err);
 
-
 /* Bytes held by the zones, the nodes, their irradiance and the occluder
  * index. */
 uint64_t forest_memory(const zone_forest *f);

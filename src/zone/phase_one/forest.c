@@ -162,7 +162,8 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
      * the memory limit before anything large is allocated. */
     const zt_render_options *o = &r->options;
     int depth = o->level >= 0 ? o->level : o->depth;
-    uint64_t per_node = MEMORY_PER_NODE + (uint64_t)(depth >= 2 ? depth : 0) * MEMORY_PER_NODE_LEVEL;
+    int map_levels = depth >= 2 ? depth : 0; /* as zone_phase_one sets them */
+    uint64_t per_node = memory_zone_nodes(1, map_levels);
     const char *source;
     uint64_t limit = memory_limit(o->max_memory, &source);
     uint64_t room = limit > r->memory_estimate ? limit - r->memory_estimate : 0;
@@ -178,7 +179,8 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
             return zt_fail(err, ZT_ERR_MEMORY, "the zone tracer's forest would have %lld surface "
                            "nodes at quality %d, more than 2^31: use a lower quality",
                            wanted, o->quality);
-        return memory_check(r->memory_estimate + (uint64_t)wanted * per_node, what, o, err);
+        return memory_check(r->memory_estimate + memory_zone_nodes(wanted, map_levels), what, o,
+                            err);
     }
     if (!built)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the surfaces' nodes");

@@ -246,7 +246,7 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
          * time Phase Two will need; one that does not is abandoned. */
         double phase_two = 0;
         int built = 0;
-        for (int level = 0; level < f->map_levels && st == ZT_OK; level++) {
+        for (int level = 0; level < f->map_levels; level++) {
             double t0 = render_clock();
             if (level > 0)
                 sender_tree_fill(&tree, &f->sn, &r->rs, zone_e(f, level - 1, 0));
