@@ -529,14 +529,7 @@ static void test_cli(void **state)
         fail_msg("render --load-forest: exit %d: %s", code, out ? out : "");
     assert_non_null(strstr(out, "read from"));
     free(out);
-    size_t na, nb;
-    char *da = test_read_file(a, &na), *db = test_read_file(b, &nb);
-    assert_non_null(da);
-    assert_non_null(db);
-    assert_int_equal(na, nb);
-    assert_memory_equal(da, db, na);
-    free(da);
-    free(db);
+    test_assert_same_file(a, b);
     /* Other options: exit 3 (invalid input) with the reason. */
     snprintf(args, sizeof args, "render '%s' --method zone --depth 3 --quality 0 -o '%s' "
              "--load-forest '%s'", scene, b, forest);
