@@ -17,6 +17,7 @@ packages=(
   xvfb xauth                         # an X server for the viewer's tests
   time                               # /usr/bin/time: peak memory in bench/zone_nseries.sh
   clang libclang-rt-dev libomp-dev   # the fuzz harnesses (libFuzzer, OpenMP for clang)
+  libopenmpi-dev openmpi-bin         # rendering across processes and machines (mpirun)
 )
 
 missing=()

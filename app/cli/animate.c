@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "cluster.h"
 
 /* Checks that pattern holds exactly one frame-number conversion (%d, %4d,
  * %04d) and otherwise only %% escapes.  Returns 1 if it has one, 0 if it
@@ -69,116 +70,192 @@ static void frame_name(char *out, size_t n, const char *pattern, int k)
     out[o < n ? o : n - 1] = '\0';
 }
 
+/* What a process sends rank 0 with its frame of a round. */
+typedef struct frame_report {
+    double seconds, rays;
+    int rendered;
+    int pad;
+} frame_report;
+
+/* Renders frame k (the scene at its time) into *img. */
+static zt_status render_frame(const zt_scene *scene0, const zt_motions *motions, zt_scene *scene,
+                              const zt_render_options *opt, const cli_animation *anim, int k,
+                              int verbose, zt_image **img, zt_render_stats *stats, zt_error *err)
+{
+    zt_status st = zt_motions_apply(motions, scene0, anim->time + k / anim->fps, opt->seed,
+                                    scene, err);
+    if (st != ZT_OK)
+        return st;
+    cli_progress prog;
+    cli_progress_init(&prog, verbose);
+    zt_render_options o = *opt;
+    o.progress = cli_progress_callback;
+    o.progress_user = &prog;
+    st = zt_render(scene, &o, img, stats, err);
+    cli_progress_finish(&prog);
+    return st;
+}
+
 int cli_animate(const char *scene_path, const zt_render_options *options,
                 const zt_tonemap *tonemap, const char *output, int width, int height,
                 const cli_animation *anim, int verbose, int quiet)
 {
+    int has_number = 0, code = EXIT_OK;
     if (!anim->motions) {
         cli_error("--frames, --fps and --time need --motions FILE");
-        return EXIT_USAGE;
-    }
-    if (!strcmp(output, "-") && anim->frames > 1) {
+        code = EXIT_USAGE;
+    } else if (!strcmp(output, "-") && anim->frames > 1) {
         cli_error("-o -: several frames cannot go to standard output; give a "
                   "name with a frame number such as frame_%%04d.png");
-        return EXIT_USAGE;
-    }
-    int has_number = strcmp(output, "-") ? check_pattern(output) : 0;
-    if (has_number < 0)
-        return EXIT_USAGE;
-    if (anim->frames > 1 && !has_number) {
+        code = EXIT_USAGE;
+    } else if ((has_number = strcmp(output, "-") ? check_pattern(output) : 0) < 0) {
+        code = EXIT_USAGE;
+    } else if (anim->frames > 1 && !has_number) {
         cli_error("-o '%s' has no frame number: with --frames %d give a pattern "
                   "such as frame_%%04d.png", output, anim->frames);
-        return EXIT_USAGE;
+        code = EXIT_USAGE;
     }
 
     zt_error err;
     zt_error_clear(&err);
     zt_scene *scene0 = NULL, *scene = NULL;
     zt_motions *motions = NULL;
-    int code = EXIT_OK;
-    zt_status st = zt_scene_load_file(scene_path, &scene0, &err);
-    if (st == ZT_OK && width) {
+    zt_status st = code == EXIT_OK ? zt_scene_load_file(scene_path, &scene0, &err) : ZT_OK;
+    if (code == EXIT_OK && st == ZT_OK && width) {
         zt_camera cam = zt_scene_get_camera(scene0);
         if (zt_camera_set_resolution(&cam, width, height, &err) != ZT_OK) {
             cli_error("%s", err.message);
-            zt_scene_release(scene0);
-            return EXIT_USAGE;
+            code = EXIT_USAGE;
+        } else {
+            zt_scene_set_camera(scene0, &cam);
         }
-        zt_scene_set_camera(scene0, &cam);
     }
-    if (st == ZT_OK)
+    if (code == EXIT_OK && st == ZT_OK)
         st = zt_motions_load_file(anim->motions, &motions, &err);
-    if (st == ZT_OK)
+    if (code == EXIT_OK && st == ZT_OK)
         st = zt_motions_check(motions, scene0, &err);
-    if (st == ZT_OK && !(scene = zt_scene_clone(scene0))) {
+    if (code == EXIT_OK && st == ZT_OK && !(scene = zt_scene_clone(scene0))) {
         st = ZT_ERR_MEMORY;
         snprintf(err.message, sizeof err.message, "out of memory");
     }
-    if (st != ZT_OK) {
-        fprintf(stderr, "zonetrace: %s\n", err.message);
+    if (code == EXIT_OK && st != ZT_OK) {
+        cli_error("%s", err.message);
         code = cli_exit_code(st);
-        goto done;
     }
+    /* Under mpirun all processes go on from here, or none. */
+    code = cluster_agree(code);
+    if (code != EXIT_OK)
+        goto done;
 
-    /* An interrupt lets the frame under way finish (a frame cut short would
-     * not match its neighbours) and starts no other. */
+    /* Frames are dealt out to the processes in rounds, frame first + rank
+     * to each, and rank 0 writes a round's frames in order.  An interrupt
+     * lets the frames under way finish (a frame cut short would not match
+     * its neighbours) and starts no other round.  Each frame is rendered
+     * whole by one process, so it is the frame one process alone makes. */
     zt_render_options opt = *options;
     opt.stop = NULL;
     cli_interrupts_install("\nzonetrace: finishing the current frame, then stopping "
                            "(interrupt again to abort it)\n");
+    const int ranks = cluster_ranks(), rank = cluster_rank();
+    zt_camera cam = zt_scene_get_camera(scene0);
+    size_t floats = 3 * (size_t)cam.width * (size_t)cam.height;
+    size_t bytes = sizeof(frame_report) + floats * sizeof(float);
+    unsigned char *mine = ranks > 1 ? calloc(1, bytes) : NULL;
+    unsigned char *all = ranks > 1 && rank == 0 ? malloc(bytes * (size_t)ranks) : NULL;
+    if (ranks > 1 && (!mine || (rank == 0 && !all)))
+        cluster_abort(EXIT_MEMORY, "out of memory for a round of frames");
     double total_seconds = 0;
     uint64_t total_rays = 0;
     int frames_done = 0;
-    for (int k = 0; k < anim->frames; k++) {
-        if (cli_stop) {
+    for (int first = 0; first < anim->frames && code == EXIT_OK; first += ranks) {
+        if (cli_stop)
             cli_error("interrupted: %d of %d frames written", frames_done, anim->frames);
-            code = EXIT_INTERRUPTED;
+        if ((code = cluster_agree(cli_stop ? EXIT_INTERRUPTED : EXIT_OK)) != EXIT_OK)
             break;
-        }
-        double t = anim->time + k / anim->fps;
+        int k = first + rank;
         char name[4096];
         if (has_number)
             frame_name(name, sizeof name, output, k);
         else
             snprintf(name, sizeof name, "%s", output);
-        st = zt_motions_apply(motions, scene0, t, options->seed, scene, &err);
-        if (st != ZT_OK) {
-            cli_error("%s", err.message);
-            code = cli_exit_code(st);
-            goto done;
-        }
-        if (!quiet || verbose)
-            fprintf(stderr, "frame %d/%d (t = %.3f s) -> %s%s", k + 1, anim->frames, t,
-                    strcmp(name, "-") ? name : "(stdout)", verbose ? "\n" : "");
-        cli_progress prog;
-        cli_progress_init(&prog, verbose);
-        opt.progress = cli_progress_callback;
-        opt.progress_user = &prog;
+        if (ranks == 1 && (!quiet || verbose))
+            fprintf(stderr, "frame %d/%d (t = %.3f s) -> %s%s", k + 1, anim->frames,
+                    anim->time + k / anim->fps, strcmp(name, "-") ? name : "(stdout)",
+                    verbose ? "\n" : "");
         zt_image *img = NULL;
         zt_render_stats stats;
-        st = zt_render(scene, &opt, &img, &stats, &err);
-        cli_progress_finish(&prog);
-        if (st == ZT_OK) {
-            st = zt_image_write(img, name, tonemap, &err);
-            zt_image_release(img);
-        }
+        memset(&stats, 0, sizeof stats);
+        st = k < anim->frames ? render_frame(scene0, motions, scene, &opt, anim, k, verbose,
+                                             &img, &stats, &err)
+                              : ZT_OK;
         if (st != ZT_OK) {
-            if (!quiet && !verbose)
+            if (ranks == 1 && !quiet && !verbose)
                 fputc('\n', stderr);
             cli_error("frame %d: %s", k, err.message);
-            code = cli_exit_code(st);
-            goto done;
         }
-        total_seconds += stats.seconds;
-        total_rays += stats.rays;
-        frames_done++;
-        if (!quiet && !verbose)
-            fprintf(stderr, ", %.2f s\n", stats.seconds);
-        cli_report_stop(&opt, &stats, quiet);
+        if ((code = cluster_agree(cli_exit_code(st))) != EXIT_OK) {
+            zt_image_release(img);
+            break;
+        }
+        if (ranks > 1) {
+            frame_report rep = {stats.seconds, (double)stats.rays, img != NULL, 0};
+            memcpy(mine, &rep, sizeof rep);
+            if (img)
+                memcpy(mine + sizeof rep, img->pixels, floats * sizeof(float));
+            zt_image_release(img);
+            img = NULL;
+            if (cluster_gather(mine, bytes, all) != 0)
+                cluster_abort(EXIT_FAILURE_OTHER, "could not send a frame to process 0");
+        }
+        /* Rank 0 writes the round's frames (one: its own, in one process). */
+        for (int j = 0; rank == 0 && j < ranks && code == EXIT_OK && first + j < anim->frames;
+             j++) {
+            int kj = first + j;
+            zt_image *out = img;
+            if (ranks > 1) {
+                frame_report rep;
+                memcpy(&rep, all + (size_t)j * bytes, sizeof rep);
+                stats.seconds = rep.seconds;
+                stats.rays = (uint64_t)rep.rays;
+                out = zt_image_create(cam.width, cam.height);
+                if (!out) {
+                    cli_error("out of memory for frame %d", kj);
+                    code = EXIT_MEMORY;
+                    break;
+                }
+                memcpy(out->pixels, all + (size_t)j * bytes + sizeof rep, floats * sizeof(float));
+                if (has_number)
+                    frame_name(name, sizeof name, output, kj);
+                if (!quiet || verbose)
+                    fprintf(stderr, "frame %d/%d (t = %.3f s) -> %s", kj + 1, anim->frames,
+                            anim->time + kj / anim->fps, strcmp(name, "-") ? name : "(stdout)");
+            }
+            st = zt_image_write(out, name, tonemap, &err);
+            zt_image_release(out);
+            img = NULL;
+            if (st != ZT_OK) {
+                if (!quiet || verbose)
+                    fputc('\n', stderr);
+                cli_error("frame %d: %s", kj, err.message);
+                code = cli_exit_code(st);
+                break;
+            }
+            total_seconds += stats.seconds;
+            total_rays += stats.rays;
+            frames_done++;
+            if ((!quiet && !verbose) || (ranks > 1 && verbose))
+                fprintf(stderr, ", %.2f s\n", stats.seconds);
+            cli_report_stop(&opt, &stats, quiet);
+        }
+        zt_image_release(img);
+        code = cluster_agree(code);
     }
+    free(mine);
+    free(all);
     if (!quiet && frames_done)
-        fprintf(stderr, "rendered %d frame%s in %.3f s: %llu rays, %.2f Mrays/s\n",
+        fprintf(stderr, "rendered %d frame%s in %.3f s%s: %llu rays, %.2f Mrays/s\n",
                 frames_done, frames_done == 1 ? "" : "s", total_seconds,
+                ranks > 1 ? " of rendering over the processes" : "",
                 (unsigned long long)total_rays,
                 total_seconds > 0 ? total_rays / total_seconds / 1e6 : 0.0);
 done:

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "cluster.h"
 
 static void print_usage(FILE *f)
 {
@@ -33,19 +34,19 @@ int cli_exit_code(zt_status status)
 
 void cli_error(const char *fmt, ...)
 {
+    char message[ZT_ERROR_MESSAGE_MAX];
     va_list ap;
     va_start(ap, fmt);
-    fputs("zonetrace: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    vsnprintf(message, sizeof message, fmt, ap);
     va_end(ap);
+    fprintf(stderr, "zonetrace: %s\n", message);
+    cluster_note(message); /* a process other than rank 0 speaks through it */
 }
 
 double cli_start;
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
-    cli_start = cli_now();
     if (argc < 2) {
         print_usage(stderr);
         return EXIT_USAGE;
@@ -56,11 +57,16 @@ int main(int argc, char **argv)
         return EXIT_OK;
     }
     if (!strcmp(cmd, "--version")) {
-        printf("zonetrace %s\n", zt_version());
+        printf("zonetrace %s%s%s\n", zt_version(), *cluster_library() ? ", with " : "",
+               cluster_library());
         return EXIT_OK;
     }
     if (!strcmp(cmd, "render"))
         return cli_render(argc - 1, argv + 1);
+    if (cluster_ranks() > 1 && cmd[0] != '-' && (!strcmp(cmd, "compare") || !strcmp(cmd, "view"))) {
+        cli_error("'%s' runs in one process: only 'render' is shared out by mpirun", cmd);
+        return EXIT_USAGE;
+    }
     if (!strcmp(cmd, "compare"))
         return cli_compare(argc - 1, argv + 1);
     if (!strcmp(cmd, "view"))
@@ -72,4 +78,13 @@ int main(int argc, char **argv)
     }
     /* "zonetrace SCENE ..." is "zonetrace render SCENE ...". */
     return cli_render(argc, argv);
+}
+
+int main(int argc, char **argv)
+{
+    cli_start = cli_now();
+    int code = cluster_start(&argc, &argv);
+    if (code != EXIT_OK)
+        return code;
+    return cluster_finish(run(argc, argv));
 }

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "cluster.h"
 #include "parse.h"
 
 static void render_usage(FILE *f)
@@ -179,7 +180,7 @@ static zt_status render_saving_forest(const zt_scene *scene, const zt_render_opt
     double t0 = cli_now();
     zt_renderer *r = NULL;
     zt_status st = zt_renderer_create(scene, opt, &r, err);
-    if (st == ZT_OK)
+    if (st == ZT_OK && cluster_rank() == 0)
         st = zt_renderer_save_forest(r, forest_out, err);
     zt_image *img = NULL;
     if (st == ZT_OK) {
@@ -202,7 +203,20 @@ static zt_status render_saving_forest(const zt_scene *scene, const zt_render_opt
     return ZT_OK;
 }
 
-int cli_render(int argc, char **argv)
+/* A render as the command line asked for it, and its loaded scene. */
+typedef struct render_job {
+    zt_render_options opt;
+    zt_tonemap tm;
+    const char *output, *scene_path, *forest_out;
+    int width, height, verbose, quiet, help;
+    double time_limit;
+    cli_animation anim;
+    zt_scene *scene; /* NULL for an animation, which loads its own */
+} render_job;
+
+/* Reads the options and loads the scene: everything that can fail before
+ * the work.  Returns an exit code (after a message). */
+static int render_prepare(int argc, char **argv, render_job *job)
 {
     zt_render_options opt = zt_render_options_default();
     zt_tonemap tm = zt_tonemap_default();
@@ -261,7 +275,7 @@ int cli_render(int argc, char **argv)
         case OPT_MAX_MEMORY: ok = parse_bytes("--max-memory", optarg, &max_memory); break;
         case 'v': verbose = 1; break;
         case 'q': quiet = 1; break;
-        case 'h': render_usage(stdout); return EXIT_OK;
+        case 'h': render_usage(stdout); job->help = 1; return EXIT_OK;
         case ':': cli_error("option '%s' needs a value", argv[optind - 1]); ok = 0; break;
         default: cli_error("unknown option '%s'", argv[optind - 1]); ok = 0; break;
         }
@@ -305,59 +319,79 @@ int cli_render(int argc, char **argv)
     int w = output_writable(output);
     if (w <= 0)
         return w < 0 ? EXIT_USAGE : EXIT_UNWRITABLE;
+    /* Only rank 0 speaks (cluster.h). */
+    if (cluster_rank() > 0) {
+        verbose = 0;
+        quiet = 1;
+    }
+    *job = (render_job){opt, tm, output, scene_path, forest_out, width, height, verbose,
+                        quiet, 0, time_limit, anim, NULL};
     if (anim.given)
-        return cli_animate(scene_path, &opt, &tm, output, width, height, &anim,
-                           verbose, quiet);
+        return EXIT_OK;
 
     zt_error err;
     zt_error_clear(&err);
-    zt_scene *scene = NULL;
-    zt_status st = zt_scene_load_file(scene_path, &scene, &err);
+    zt_status st = zt_scene_load_file(scene_path, &job->scene, &err);
     if (st != ZT_OK) {
-        fprintf(stderr, "zonetrace: %s\n", err.message);
+        cli_error("%s", err.message);
         return cli_exit_code(st);
     }
     if (width) {
-        zt_camera cam = zt_scene_get_camera(scene);
+        zt_camera cam = zt_scene_get_camera(job->scene);
         if (zt_camera_set_resolution(&cam, width, height, &err) != ZT_OK) {
             cli_error("%s", err.message);
-            zt_scene_release(scene);
             return EXIT_USAGE;
         }
-        zt_scene_set_camera(scene, &cam);
+        zt_scene_set_camera(job->scene, &cam);
     }
+    return EXIT_OK;
+}
+
+static void print_scene(const render_job *job)
+{
+    const zt_render_options *o = &job->opt;
+    zt_scene_info info;
+    zt_scene_get_info(job->scene, &info);
+    zt_camera cam = zt_scene_get_camera(job->scene);
+    fprintf(stderr, "scene %s: %d lights (%d parts), %d things (%d parts), %dx%d\n",
+            job->scene_path, info.lights, info.light_parts, info.things, info.thing_parts,
+            cam.width, cam.height);
+    if (info.meshes)
+        fprintf(stderr, "meshes: %d, %lld triangles (%lld degenerate ones skipped)\n",
+                info.meshes, info.mesh_triangles, info.skipped_triangles);
+    if (info.replaced_normals)
+        fprintf(stderr, "note: %lld vertex normals of the models were not finite or "
+                "zero and were replaced by the faces' normals\n", info.replaced_normals);
+    if (info.rough_materials)
+        fprintf(stderr, "note: %d model materials have a roughness, which is ignored: "
+                "metal, mirror and glass lobes are smooth\n", info.rough_materials);
+    if (info.missing_textures)
+        fprintf(stderr, "note: %d model textures are missing or unreadable and were left "
+                "out (%s)\n", info.missing_textures, info.texture_problem);
+    fprintf(stderr, "method %s, depth %d, level %s%d\n",
+            o->method == ZT_METHOD_PATH ? "path" : "zone", o->depth,
+            o->level < 0 ? "all up to " : "", o->level < 0 ? o->depth : o->level);
+    if (o->method == ZT_METHOD_ZONE)
+        fprintf(stderr, "zone tracer: strategy %s, quality %d, cutoff %g%s%s\n",
+                o->strategy == ZT_STRATEGY_ZONE ? "zone" : "pixel", o->quality, o->cutoff,
+                o->forest_file ? ", forest from " : "", o->forest_file ? o->forest_file : "");
+    if (cluster_ranks() > 1)
+        fprintf(stderr, "processes: %d (MPI); --threads is per process\n", cluster_ranks());
+}
+
+/* Renders the prepared scene and writes the image.  Returns an exit code. */
+static int render_image(render_job *job)
+{
+    zt_render_options opt = job->opt;
+    zt_error err;
+    zt_error_clear(&err);
     cli_progress prog;
-    cli_progress_init(&prog, verbose);
+    cli_progress_init(&prog, job->verbose);
     opt.progress = cli_progress_callback;
     opt.progress_user = &prog;
-    if (verbose) {
-        zt_scene_info info;
-        zt_scene_get_info(scene, &info);
-        zt_camera cam = zt_scene_get_camera(scene);
-        fprintf(stderr, "scene %s: %d lights (%d parts), %d things (%d parts), %dx%d\n",
-                scene_path, info.lights, info.light_parts, info.things, info.thing_parts,
-                cam.width, cam.height);
-        if (info.meshes)
-            fprintf(stderr, "meshes: %d, %lld triangles (%lld degenerate ones skipped)\n",
-                    info.meshes, info.mesh_triangles, info.skipped_triangles);
-        if (info.replaced_normals)
-            fprintf(stderr, "note: %lld vertex normals of the models were not finite or "
-                    "zero and were replaced by the faces' normals\n", info.replaced_normals);
-        if (info.rough_materials)
-            fprintf(stderr, "note: %d model materials have a roughness, which is ignored: "
-                    "metal, mirror and glass lobes are smooth\n", info.rough_materials);
-        if (info.missing_textures)
-            fprintf(stderr, "note: %d model textures are missing or unreadable and were left "
-                    "out (%s)\n", info.missing_textures, info.texture_problem);
-        fprintf(stderr, "method %s, depth %d, level %s%d\n",
-                opt.method == ZT_METHOD_PATH ? "path" : "zone", opt.depth,
-                opt.level < 0 ? "all up to " : "", opt.level < 0 ? opt.depth : opt.level);
-        if (opt.method == ZT_METHOD_ZONE)
-            fprintf(stderr, "zone tracer: strategy %s, quality %d, cutoff %g%s%s\n",
-                    opt.strategy == ZT_STRATEGY_ZONE ? "zone" : "pixel", opt.quality,
-                    opt.cutoff, opt.forest_file ? ", forest from " : "",
-                    opt.forest_file ? opt.forest_file : "");
-    }
+    opt.share = cluster_share();
+    if (job->verbose)
+        print_scene(job);
     zt_image *img = NULL;
     zt_render_stats stats;
     cli_interrupts_install(opt.method == ZT_METHOD_PATH
@@ -366,15 +400,17 @@ int cli_render(int argc, char **argv)
                                : "\nzonetrace: building no further level, then rendering "
                                  "(interrupt again to abort with nothing written)\n");
     opt.stop = &cli_stop;
-    if (time_limit > 0) {
-        zt_camera cam = zt_scene_get_camera(scene);
-        opt.time_limit = cli_time_left(time_limit, (long long)cam.width * cam.height);
+    if (job->time_limit > 0) {
+        zt_camera cam = zt_scene_get_camera(job->scene);
+        opt.time_limit = cli_time_left(job->time_limit, (long long)cam.width * cam.height);
     }
-    st = forest_out ? render_saving_forest(scene, &opt, forest_out, &img, &stats, &err)
-                    : zt_render(scene, &opt, &img, &stats, &err);
+    zt_status st = job->forest_out ? render_saving_forest(job->scene, &opt, job->forest_out,
+                                                          &img, &stats, &err)
+                                   : zt_render(job->scene, &opt, &img, &stats, &err);
     cli_progress_finish(&prog);
-    zt_scene_release(scene);
     if (st != ZT_OK) {
+        if (cluster_ranks() > 1) /* the others may be waiting inside the render */
+            cluster_abort(cli_exit_code(st), err.message);
         cli_error("%s", err.message);
         if (st == ZT_ERR_MEMORY)
             fprintf(stderr, "zonetrace: (--max-memory SIZE sets the limit; the estimate is "
@@ -383,29 +419,50 @@ int cli_render(int argc, char **argv)
             fprintf(stderr, "zonetrace: interrupted before any image: nothing written\n");
         return cli_exit_code(st);
     }
-    st = zt_image_write(img, output, &tm, &err);
+    if (cluster_rank() == 0)
+        st = zt_image_write(img, job->output, &job->tm, &err);
     zt_image_release(img);
     if (st != ZT_OK) {
         cli_error("%s", err.message);
         return cli_exit_code(st);
     }
-    if (!quiet) {
+    if (!job->quiet) {
         /* The path tracer's rays per second count the tracing alone: on a
          * large model the acceleration build can take longer than the
          * image.  The zone tracer's rays include Phase One's. */
         double t = opt.method == ZT_METHOD_PATH ? stats.trace_seconds : stats.seconds;
         double rps = t > 0 ? stats.rays / t : 0;
         fprintf(stderr, "rendered %s in %.3f s (%.3f s preparing the scene): %llu samples, "
-                "%llu rays, %.2f Mrays/s, %d threads\n",
-                strcmp(output, "-") ? output : "(stdout)", stats.seconds,
+                "%llu rays, %.2f Mrays/s, %d threads%s\n",
+                strcmp(job->output, "-") ? job->output : "(stdout)", stats.seconds,
                 stats.seconds - stats.trace_seconds, (unsigned long long)stats.samples,
-                (unsigned long long)stats.rays, rps / 1e6, stats.threads);
+                (unsigned long long)stats.rays, rps / 1e6, stats.threads,
+                cluster_ranks() > 1 ? " per process" : "");
     }
-    if (verbose && opt.method == ZT_METHOD_ZONE)
+    if (job->verbose && opt.method == ZT_METHOD_ZONE)
         print_zone_stats(&stats, opt.forest_file);
-    if (verbose)
+    if (job->verbose)
         fprintf(stderr, "memory: %.1f MiB estimated before the work (docs/long-renders.md)\n",
                 stats.memory_estimate / 1048576.0);
-    cli_report_stop(&opt, &stats, quiet);
+    if (cluster_rank() == 0)
+        cli_report_stop(&opt, &stats, job->quiet);
     return stats.stopped == ZT_STOP_INTERRUPT ? EXIT_INTERRUPTED : EXIT_OK;
+}
+
+int cli_render(int argc, char **argv)
+{
+    render_job job;
+    memset(&job, 0, sizeof job);
+    /* Under mpirun every process gets this far, and all go on, or all
+     * stop with the first failure's message and status. */
+    int code = cluster_agree(render_prepare(argc, argv, &job));
+    if (code == EXIT_OK && !job.help) {
+        if (job.anim.given)
+            code = cli_animate(job.scene_path, &job.opt, &job.tm, job.output, job.width,
+                               job.height, &job.anim, job.verbose, job.quiet);
+        else
+            code = cluster_agree(render_image(&job));
+    }
+    zt_scene_release(job.scene);
+    return code;
 }

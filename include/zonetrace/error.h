@@ -12,7 +12,8 @@
 extern "C" {
 #endif
 
-/* The numeric values double as the command line's exit codes. */
+/* The numeric values up to 7 double as the command line's exit codes (it
+ * reports ZT_ERR_EXCHANGE as 7, other failure: its 8 is an interrupt). */
 typedef enum zt_status {
     ZT_OK = 0,
     ZT_ERR_ARGUMENT = 1,    /* a bad option or parameter from the caller */
@@ -21,7 +22,9 @@ typedef enum zt_status {
     ZT_ERR_WRITE = 4,       /* an output file cannot be written */
     ZT_ERR_MEMORY = 5,      /* out of memory */
     ZT_ERR_UNSUPPORTED = 6, /* a valid request this build cannot do */
-    ZT_ERR_CANCELLED = 7    /* a progress callback asked to stop */
+    ZT_ERR_CANCELLED = 7,   /* a progress callback asked to stop */
+    ZT_ERR_EXCHANGE = 9     /* the processes of a shared render (zt_share)
+                               could not exchange their work */
 } zt_status;
 
 #define ZT_ERROR_MESSAGE_MAX 512

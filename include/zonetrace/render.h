@@ -11,6 +11,7 @@
 #define ZONETRACE_RENDER_H
 
 #include <signal.h>
+#include <stddef.h>
 #include <stdint.h>
 #include "zonetrace/error.h"
 #include "zonetrace/image.h"
@@ -34,6 +35,24 @@ typedef int (*zt_progress_fn)(void *user, const char *stage, double done,
                               double total);
 
 #define ZT_MAX_LIGHTS_OFF 64
+
+/* One of several processes rendering the same scene with the same options
+ * (MPI ranks: docs/cluster.md).  The work is dealt out in units (rows of
+ * tiles, rows of pixels, blocks of Phase One's nodes) round-robin by rank,
+ * and the processes exchange results through merge; every process ends
+ * with the image, the same bit for bit as one process renders. */
+typedef struct zt_share {
+    int rank;   /* this process: 0 .. ranks - 1 */
+    int ranks;  /* >= 1 */
+    /* Called by every process at the same points in the same order, with a
+     * buffer of the same size whose every byte is either written by one
+     * process alone (the others hold 0 there) or equal on all of them.  On
+     * return each process's buffer holds the bitwise OR of all of them:
+     * what each process wrote, everywhere.  Returns 0, or non-zero when the
+     * exchange failed (the render then fails with ZT_ERR_EXCHANGE). */
+    int (*merge)(void *user, void *buffer, size_t bytes);
+    void *user;
+} zt_share;
 
 typedef struct zt_render_options {
     zt_method method;
@@ -87,6 +106,16 @@ typedef struct zt_render_options {
      * scene, acceleration structure, zone forest) passes it fails before
      * the work with ZT_ERR_MEMORY and a message with the size it needs. */
     uint64_t max_memory;
+
+    /* When not NULL with ranks > 1: this process does its share of the
+     * work of zt_render (path tracer: its rows of tiles; zone tracer: its
+     * blocks of nodes at every level of Phase One and its rows of Phase
+     * Two) and of a zone renderer's zt_renderer_create and
+     * zt_renderer_accumulate; the path tracer's zt_renderer_accumulate
+     * refuses it.  Stops, time limits and checkpoints are agreed: the
+     * passes are the ones the slowest process can fit, and only rank 0
+     * reads and writes the checkpoint file. */
+    const zt_share *share;
 } zt_render_options;
 
 /* Defaults: path method, 64 spp, depth 16, all levels, seed 0, all cores. */

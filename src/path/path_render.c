@@ -11,14 +11,21 @@
 #include "geom/accel.h"
 #include "path/path_tracer.h"
 #include "render/render_internal.h"
+#include "render/share.h"
 #include "util/error.h"
 #include "util/sampler.h"
 
 #define TILE 16
 
-int path_tile_count(int width, int height)
+int path_tile_row(int y)
 {
-    return ((width + TILE - 1) / TILE) * ((height + TILE - 1) / TILE);
+    return y / TILE;
+}
+
+long long path_tiles_owned(const zt_render_options *o, int width, int height)
+{
+    long long per_row = (width + TILE - 1) / TILE;
+    return per_row * share_owned(o, (height + TILE - 1) / TILE);
 }
 
 zt_status path_accumulate_into(zt_renderer *r, int first, int count, path_sums out,
@@ -46,12 +53,13 @@ zt_status path_accumulate_into(zt_renderer *r, int first, int count, path_sums o
     }
     /* A shared progress counts tiles times samples. */
     const double tile_work = shared ? (double)count : 1.0;
-    uint64_t rays = 0;
+    uint64_t rays = 0, samples = 0;
     const uint32_t s0 = (uint32_t)first, s1 = (uint32_t)first + (uint32_t)count;
 
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays, samples)
     for (int t = 0; t < tiles; t++) {
-        if (prog->cancelled)
+        /* Split over processes, each takes its rows of tiles. */
+        if (prog->cancelled || !share_owns(o, t / tiles_x))
             continue;
         int x0 = (t % tiles_x) * TILE, y0 = (t / tiles_x) * TILE;
         int x1 = x0 + TILE < width ? x0 + TILE : width;
@@ -84,11 +92,12 @@ zt_status path_accumulate_into(zt_renderer *r, int first, int count, path_sums o
                 }
             }
         rays += local_rays;
+        samples += (uint64_t)(x1 - x0) * (uint64_t)(y1 - y0) * (uint64_t)count;
         progress_add(prog, tile_work);
     }
     stats->threads = threads;
     stats->rays = rays;
-    stats->samples = (uint64_t)width * (uint64_t)height * (uint64_t)count;
+    stats->samples = samples;
     if (prog->cancelled)
         return zt_fail(err, ZT_ERR_CANCELLED, "render cancelled");
     return ZT_OK;
@@ -97,6 +106,9 @@ zt_status path_accumulate_into(zt_renderer *r, int first, int count, path_sums o
 zt_status path_accumulate(zt_renderer *r, int first, int count, zt_image *sum,
                           zt_render_stats *stats, zt_error *err)
 {
+    if (share_ranks(&r->options) > 1)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "the path tracer's accumulation runs in one "
+                       "process; zt_render splits a render over processes");
     path_sums out = {NULL, sum->pixels, sum->width, sum->height};
     return path_accumulate_into(r, first, count, out, NULL, stats, err);
 }

@@ -5,9 +5,11 @@
  * samples fall into passes, runs and resumptions, the bits are the same. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "render/checkpoint.h"
 #include "render/render_internal.h"
+#include "render/share.h"
 #include "util/error.h"
 
 /* A pass takes about this long once the time per sample is known: short
@@ -38,8 +40,68 @@ static zt_status save(const zt_renderer *r, uint64_t key, int done, const double
                       zt_error *err)
 {
     const zt_camera *c = &r->scene->camera;
+    if (share_rank(&r->options) != 0)
+        return ZT_OK; /* rank 0 alone keeps the checkpoint */
     return checkpoint_write(r->options.checkpoint_file, key, c->width, c->height, done, sums,
                             err);
+}
+
+/* Split over processes, each holds its own rows of tiles: the others'
+ * pixels are cleared (they hold an earlier merge's or a checkpoint's sums)
+ * and the merge gives every process the whole image. */
+static zt_status gather_sums(const zt_renderer *r, double *sums, zt_error *err)
+{
+    const zt_render_options *o = &r->options;
+    if (share_ranks(o) == 1)
+        return ZT_OK;
+    const int w = r->scene->camera.width, h = r->scene->camera.height;
+    for (int y = 0; y < h; y++)
+        if (!share_owns(o, path_tile_row(y)))
+            memset(sums + 3 * (size_t)y * (size_t)w, 0, 3 * (size_t)w * sizeof *sums);
+    return share_merge(o, sums, 3 * (size_t)w * (size_t)h * sizeof *sums, err);
+}
+
+/* Rank 0 reads the checkpoint; the others learn whether it could and take
+ * its sums and count. */
+static zt_status resume(const zt_renderer *r, uint64_t key, double *sums, int *done,
+                        zt_error *err)
+{
+    const zt_render_options *o = &r->options;
+    const zt_camera *c = &r->scene->camera;
+    zt_status st = ZT_OK;
+    if (share_rank(o) == 0)
+        st = checkpoint_read(o->checkpoint_file, key, c->width, c->height, o->spp, sums, done,
+                             err);
+    if (share_ranks(o) == 1)
+        return st;
+    /* Rank 0's status and count; the others' are 0. */
+    double told[2] = {st, *done};
+    zt_error ex;
+    if (share_max(o, told, 2, &ex) != ZT_OK)
+        return zt_fail(err, ex.status, "%s", ex.message);
+    if (told[0] != ZT_OK)
+        return st != ZT_OK ? st
+                           : zt_fail(err, (zt_status)told[0], "the checkpoint '%s' could not "
+                                     "be resumed (process 0 says why)", o->checkpoint_file);
+    *done = (int)told[1];
+    return share_merge(o, sums, 3 * (size_t)c->width * (size_t)c->height * sizeof *sums, err);
+}
+
+/* What the processes do next, agreed: stop if any was asked to, a pass
+ * that fits on all of them, a checkpoint if any is due one. */
+typedef struct pass_plan {
+    int stop, count, save;
+} pass_plan;
+
+static zt_status agree(const zt_render_options *o, pass_plan *p, zt_error *err)
+{
+    /* The fewest samples is the most of their negatives. */
+    double x[3] = {p->stop, -p->count, p->save};
+    zt_status st = share_max(o, x, 3, err);
+    p->stop = x[0] != 0;
+    p->count = (int)-x[1];
+    p->save = x[2] != 0;
+    return st;
 }
 
 zt_status path_render_passes(zt_renderer *r, double t0, zt_image **out,
@@ -59,42 +121,56 @@ zt_status path_render_passes(zt_renderer *r, double t0, zt_image **out,
     uint64_t key = o->checkpoint_file ? checkpoint_key(r->scene, o) : 0;
     zt_status st = ZT_OK;
     if (o->resume)
-        st = checkpoint_read(o->checkpoint_file, key, w, h, o->spp, sums, &done, err);
+        st = resume(r, key, sums, &done, err);
     stats->spp_resumed = done;
 
     progress prog;
-    progress_init(&prog, o, "path", (double)path_tile_count(w, h) * (o->spp - done));
+    progress_init(&prog, o, "path", (double)path_tiles_owned(o, w, h) * (o->spp - done));
     double deadline = o->time_limit > 0 ? t0 + o->time_limit : INFINITY;
     double every = o->checkpoint_seconds > 0 ? o->checkpoint_seconds : CHECKPOINT_SECONDS;
     double last_save = render_clock(), per_sample = 0;
     while (st == ZT_OK && done < o->spp) {
-        if (o->stop && *o->stop) {
+        double now = render_clock();
+        pass_plan plan = {o->stop && *o->stop, next_pass(o, done, per_sample, now, deadline),
+                          o->checkpoint_file && done > 0 && now - last_save >= every};
+        st = agree(o, &plan, err);
+        if (st == ZT_OK && plan.save) {
+            st = gather_sums(r, sums, err);
+            if (st == ZT_OK)
+                st = save(r, key, done, sums, err);
+            last_save = render_clock();
+        }
+        if (st != ZT_OK)
+            break;
+        if (plan.stop) {
             stats->stopped = ZT_STOP_INTERRUPT;
             break;
         }
-        double now = render_clock();
-        int count = next_pass(o, done, per_sample, now, deadline);
-        if (count == 0) {
+        if (plan.count == 0) {
             stats->stopped = ZT_STOP_TIME;
             break;
         }
+        now = render_clock();
         zt_render_stats ps = {0};
-        st = path_accumulate_into(r, done, count, (path_sums){sums, NULL, w, h}, &prog, &ps, err);
+        st = path_accumulate_into(r, done, plan.count, (path_sums){sums, NULL, w, h}, &prog, &ps,
+                                  err);
         if (st != ZT_OK)
             break;
-        double after = render_clock();
-        done += count;
-        per_sample = fmax((after - now) / count, 1e-9); /* > 0: measured */
+        done += plan.count;
+        per_sample = fmax((render_clock() - now) / plan.count, 1e-9); /* > 0: measured */
         stats->rays += ps.rays;
         stats->samples += ps.samples;
         stats->threads = ps.threads;
-        if (o->checkpoint_file && done < o->spp && after - last_save >= every) {
-            st = save(r, key, done, sums, err);
-            last_save = render_clock();
-        }
     }
     if (st == ZT_OK && done == 0)
         st = zt_fail(err, ZT_ERR_CANCELLED, "stopped before the first sample");
+    if (st == ZT_OK)
+        st = gather_sums(r, sums, err);
+    double counts[2] = {(double)stats->rays, (double)stats->samples};
+    if (st == ZT_OK && (st = share_sum(o, counts, 2, err)) == ZT_OK) {
+        stats->rays = (uint64_t)counts[0];
+        stats->samples = (uint64_t)counts[1];
+    }
     if (st == ZT_OK && o->checkpoint_file)
         st = save(r, key, done, sums, err);
     if (st == ZT_OK)

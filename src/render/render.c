@@ -73,6 +73,12 @@ static zt_status check_options(const zt_scene *scene, const zt_render_options *o
                        "tracer keeps its Phase One in a forest file)");
     if (o->resume && !o->checkpoint_file)
         return zt_fail(err, ZT_ERR_ARGUMENT, "resuming needs a checkpoint file");
+    if (o->share && (o->share->ranks < 1 || o->share->rank < 0 ||
+                     o->share->rank >= o->share->ranks ||
+                     (o->share->ranks > 1 && !o->share->merge)))
+        return zt_fail(err, ZT_ERR_ARGUMENT, "bad process share: rank %d of %d%s",
+                       o->share->rank, o->share->ranks,
+                       o->share->merge ? "" : " without a merge function");
     if (!scene->has_camera)
         return zt_fail(err, ZT_ERR_ARGUMENT, "the scene has no camera");
     return check_camera(&scene->camera, err);

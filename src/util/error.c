@@ -22,6 +22,7 @@ const char *zt_status_name(zt_status status)
     case ZT_ERR_MEMORY: return "out of memory";
     case ZT_ERR_UNSUPPORTED: return "unsupported";
     case ZT_ERR_CANCELLED: return "cancelled";
+    case ZT_ERR_EXCHANGE: return "exchange between processes failed";
     }
     return "unknown error";
 }

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "render/memory.h"
+#include "render/share.h"
 #include "util/error.h"
 #include "zone/io/forest_io.h"
 #include "zone/phase_two/phase_two.h"
@@ -85,13 +86,29 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
         st = zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixel marks");
     c.marks = &marks;
     uint64_t rays = 0;
+    /* Split over processes, each renders its rows into an image of its
+     * own, the merge joins them, and the whole is added to sum: the same
+     * additions, in the same order, as one process makes. */
+    int shared = !reference && share_ranks(o) > 1;
+    zt_image *own = shared ? zt_image_create(sum->width, sum->height) : sum;
+    if (st == ZT_OK && !own)
+        st = zt_fail(err, ZT_ERR_MEMORY, "out of memory for a %dx%d image", sum->width,
+                     sum->height);
     if (st == ZT_OK) {
         if (reference)
-            st = p2_render_reference(&c, sum, &rays, err);
+            st = p2_render_reference(&c, own, &rays, err);
         else if (o->strategy == ZT_STRATEGY_ZONE)
-            st = p2_render_zones(&c, sum, &rays, err);
+            st = p2_render_zones(&c, own, &rays, err);
         else
-            st = p2_render_pixels(&c, sum, &rays, err);
+            st = p2_render_pixels(&c, own, &rays, err);
+    }
+    if (shared && own) {
+        size_t n = 3 * (size_t)sum->width * (size_t)sum->height;
+        if (st == ZT_OK)
+            st = share_merge(o, own->pixels, n * sizeof *own->pixels, err);
+        for (size_t i = 0; st == ZT_OK && i < n; i++)
+            sum->pixels[i] += own->pixels[i];
+        zt_image_release(own);
     }
     p2_terms_free(&c.terms);
     p2_marks_free(&marks);
@@ -100,6 +117,9 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
         /* Phase One's rays are charged to the first image, unless the
          * forest was read from a file. */
         stats->rays = rays + (f->images == 0 && !f->loaded ? f->rays : 0);
+        double all = (double)stats->rays;
+        if (shared && st == ZT_OK && (st = share_sum(o, &all, 1, err)) == ZT_OK)
+            stats->rays = (uint64_t)all; /* every process's */
         stats->samples = (uint64_t)sum->width * sum->height * (uint64_t)(c.g * c.g);
         /* Phase One is charged to the first image of the renderer only. */
         stats->phase_one_seconds = f->images == 0 ? f->phase_one_seconds : 0.0;

@@ -17,6 +17,7 @@
 
 #include "geom/accel.h"
 #include "geom/ray_offset.h"
+#include "render/share.h"
 #include "util/error.h"
 #include "util/vec3_convert.h"
 #include "zone/phase_one/caustic.h"
@@ -137,18 +138,24 @@ static int straight(const surface_nodes *sn, const float *v, const int32_t line[
     return 1;
 }
 
+/* Nodes are dealt to processes in blocks this long (render/share.h). */
+#define NODE_BLOCK 64
+
 /* E_level at every live node, added to what is there (caustics).  Coarse
  * nodes first; a finer node midway between coarser ones on a straight
  * stretch is their mean (surface_node_line), else it is computed too.  The
  * rounds depend on nothing but the nodes, so the values are the same on
- * any thread count.  When the clock passes `until` or the render is asked
- * to stop, the level is abandoned: *abandoned is set and nothing changes. */
+ * any thread count; split over processes, each computes its blocks of a
+ * round and the merge after it gives all of them the round.  When the clock
+ * passes `until` or the render is asked to stop (on any process), the level
+ * is abandoned: *abandoned is set and nothing changes. */
 static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
                              const sender_tree *tree, double until, int *abandoned,
                              zt_error *err)
 {
     const rscene *rs = &r->rs;
     const surface_nodes *sn = &f->sn;
+    const zt_render_options *o = &r->options;
     transfer_ctx tc = {tree, sn, rs, level > 0 ? zone_e(f, level - 1, 0) : NULL,
                        f->q.eps, f->q.theta, 0, 4096};
     /* Receivers far darker than the scene's average need no fine cut. */
@@ -158,18 +165,19 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
     if (!v)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for level %d's node values", level);
     uint64_t rays = 0, links = 0;
-    int threads = render_thread_count(r->options.threads);
-    const volatile sig_atomic_t *stop = r->options.stop;
+    int threads = render_thread_count(o->threads);
+    const volatile sig_atomic_t *stop = o->stop;
     int quit = 0;
-    for (int pass = 0; pass < NODE_ROUNDS && !quit; pass++) {
-#pragma omp parallel for schedule(dynamic, 64) num_threads(threads) reduction(+ : rays, links)
+    zt_status st = ZT_OK;
+    for (int pass = 0; pass < NODE_ROUNDS && !quit && st == ZT_OK; pass++) {
+#pragma omp parallel for schedule(dynamic, NODE_BLOCK) num_threads(threads) reduction(+ : rays, links)
         for (int k = 0; k < sn->node_count; k++) {
             int q;
 #pragma omp atomic read
             q = quit;
-            if (q || !sn->live[k])
+            if (q || !sn->live[k] || !share_owns(o, k / NODE_BLOCK))
                 continue;
-            if (k % 64 == 0 && (render_clock() > until || (stop && *stop))) {
+            if (k % NODE_BLOCK == 0 && (render_clock() > until || (stop && *stop))) {
 #pragma omp atomic write
                 quit = 1;
                 continue;
@@ -191,10 +199,19 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
             v[3 * (size_t)k + 1] = (float)e.y;
             v[3 * (size_t)k + 2] = (float)e.z;
         }
+        if (share_ranks(o) > 1) {
+            /* Earlier rounds' values are equal everywhere, this round's
+             * each written by one process. */
+            double q = quit;
+            st = share_merge(o, v, 3 * (size_t)sn->node_count * sizeof *v, err);
+            if (st == ZT_OK)
+                st = share_max(o, &q, 1, err);
+            quit = q != 0;
+        }
     }
     f->rays += rays;
     *abandoned = quit;
-    if (!quit)
+    if (!quit && st == ZT_OK)
         for (int k = 0; k < sn->node_count; k++) {
             float *px = zone_e(f, level, k);
             for (int ch = 0; ch < 3; ch++)
@@ -202,7 +219,7 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
         }
     free(v);
     f->links += links;
-    return ZT_OK;
+    return st;
 }
 
 /* The time limit: Phase Two must fit after the last level.  It costs about
@@ -271,6 +288,15 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
             r->options.depth = built > 1 ? built : 1;
             f->map_levels = built > 1 ? built : 0;
         }
+    }
+    if (share_ranks(&r->options) > 1) {
+        /* The counts are the whole job's, as one process's would be. */
+        double n[2] = {(double)f->rays, (double)f->links};
+        st = share_sum(&r->options, n, 2, err);
+        if (st != ZT_OK)
+            return st;
+        f->rays = (uint64_t)n[0];
+        f->links = (uint64_t)n[1];
     }
     return zone_forest_zones(f, r, err);
 }

@@ -11,10 +11,13 @@
  *
  * Each pixel's value is summed in double precision by p2_apply in both, over
  * the same terms in the same order, then added to the float image once: the
- * two images are identical bit for bit, at any thread count. */
+ * two images are identical bit for bit, at any thread count.  Split over
+ * processes, each renders its rows (render/share.h) and leaves the others
+ * untouched. */
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/share.h"
 #include "util/error.h"
 #include "zone/phase_two/phase_two.h"
 
@@ -84,7 +87,7 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
     const zt_render_options *o = &c->r->options;
     int threads = render_thread_count(o->threads);
     progress prog;
-    progress_init(&prog, o, "zone", (double)sum->height);
+    progress_init(&prog, o, "zone", (double)share_owned(o, sum->height));
     uint64_t rays = 0;
     volatile int failed = 0; /* set by any thread that runs out of memory */
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
@@ -95,7 +98,7 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
         int *list = NULL, cap = 0;
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < sum->height; y++) {
-            if (prog.cancelled || failed)
+            if (prog.cancelled || failed || !share_owns(o, y))
                 continue;
             if (!p2_row_build(c, y, &row, &t.rays)) {
                 failed = 1;
@@ -188,13 +191,13 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
         goto done;
     }
     progress prog;
-    progress_init(&prog, o, "zone samples", (double)h);
+    progress_init(&prog, o, "zone samples", (double)share_owned(o, h));
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
         uint64_t r = 0;
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < h; y++) {
-            if (prog.cancelled || failed)
+            if (prog.cancelled || failed || !share_owns(o, y))
                 continue;
             if (!p2_row_build(c, y, &rows[y], &r))
                 failed = 1;
@@ -219,7 +222,7 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
             last[q] = -1;
         size_t total_hits = 0, total_lights = 0;
         for (int y = 0; y < h; y++)
-            for (int x = 0; x < w; x++) {
+            for (int x = 0; x < w && share_owns(o, y); x++) {
                 p2_pixel px;
                 p2_row_pixel(&rows[y], x, y, &px);
                 int pi = y * w + x;
@@ -308,7 +311,7 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
         goto done;
     }
     for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++)
+        for (int x = 0; x < w && share_owns(o, y); x++)
             add_to_image(sum, x, y, acc + ((size_t)y * w + x) * 3);
 
 done:

@@ -1,0 +1,258 @@
+/* Rendering across processes (docs/cluster.md): `mpirun -n R zonetrace
+ * render` writes the same bytes as one process, for R = 1, 2 and 3, with
+ * the path tracer (also resumed at another R), the zone tracer (both
+ * strategies, and its forest file) and an animation; a process that fails
+ * ends the job with the message and status one process would give, never a
+ * hang.  Without MPI in the build, the program refuses to run as one of
+ * several processes. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+
+#include "test_support.h"
+
+#ifdef ZT_MPIEXEC
+#define JOB_SECONDS "120" /* a job that hangs is killed, and the test fails */
+
+/* Runs "mpiexec -n ranks zonetrace ARGS"; args may hold MPMD parts
+ * (" : -n 1 zonetrace ..."), with @ZT@ standing for the program. */
+static int run_job(int ranks, const char *args, char **err_out)
+{
+    char expanded[8192] = "", *o = expanded;
+    for (const char *p = args; *p && o < expanded + sizeof expanded - 600; p++) {
+        if (!strncmp(p, "@ZT@", 4)) {
+            o += sprintf(o, "'%s'", ZT_CLI_PATH);
+            p += 3;
+        } else {
+            *o++ = *p;
+        }
+    }
+    *o = '\0';
+    const char *errpath = test_tmp_path("job_stderr.txt");
+    char cmd[10000];
+    snprintf(cmd, sizeof cmd, "timeout " JOB_SECONDS " '%s' --oversubscribe -n %d '%s' %s "
+             "2>'%s' </dev/null", ZT_MPIEXEC, ranks, ZT_CLI_PATH, expanded, errpath);
+    int status = system(cmd);
+    char *err = test_read_file(errpath, NULL);
+    if (err_out)
+        *err_out = err;
+    else
+        free(err);
+    if (status == -1 || !WIFEXITED(status))
+        return -1;
+    assert_int_not_equal(WEXITSTATUS(status), 124); /* timeout: a hang */
+    return WEXITSTATUS(status);
+}
+
+static const char *cornell(void)
+{
+    static char path[1024];
+    snprintf(path, sizeof path, "%s/scenes/cornell.json", ZT_SOURCE_DIR);
+    return path;
+}
+
+/* One process's output, then R = 1, 2, 3 processes' (name_R.ext), the
+ * same bytes. */
+static void same_at_every_count(const char *options, const char *name, const char *ext)
+{
+    char args[4096], one[256];
+    snprintf(one, sizeof one, "%s_single.%s", name, ext);
+    snprintf(args, sizeof args, "render '%s' %s -q -o '%s'", cornell(), options,
+             test_tmp_path(one));
+    assert_int_equal(test_run_cli(args, NULL), 0);
+    for (int ranks = 1; ranks <= 3; ranks++) {
+        char mine[256], *err = NULL;
+        snprintf(mine, sizeof mine, "%s_%d.%s", name, ranks, ext);
+        snprintf(args, sizeof args, "render '%s' %s --threads 1 -q -o '%s'", cornell(), options,
+                 test_tmp_path(mine));
+        int rc = run_job(ranks, args, &err);
+        if (rc != 0)
+            fail_msg("%d processes: exit %d: %s", ranks, rc, err ? err : "");
+        free(err);
+        char a[1024];
+        snprintf(a, sizeof a, "%s", test_tmp_path(one));
+        test_assert_same_file(a, test_tmp_path(mine));
+    }
+}
+
+static void test_path_tracer(void **state)
+{
+    (void)state;
+    same_at_every_count("--size 40x30 --spp 6 --seed 3", "path", "pfm");
+}
+
+/* A checkpoint written by 2 processes resumed by 3 gives one process's
+ * image. */
+static void test_path_resumed(void **state)
+{
+    (void)state;
+    char args[4096], check[1024], one[1024], mine[1024];
+    snprintf(check, sizeof check, "%s", test_tmp_path("job.ztcheck"));
+    snprintf(one, sizeof one, "%s", test_tmp_path("resume_single.pfm"));
+    snprintf(mine, sizeof mine, "%s", test_tmp_path("resume_3.pfm"));
+    snprintf(args, sizeof args, "render '%s' --size 40x30 --spp 7 -q -o '%s'", cornell(), one);
+    assert_int_equal(test_run_cli(args, NULL), 0);
+    snprintf(args, sizeof args, "render '%s' --size 40x30 --spp 3 --checkpoint '%s' -q -o '%s'",
+             cornell(), check, test_tmp_path("resume_part.pfm"));
+    assert_int_equal(run_job(2, args, NULL), 0);
+    snprintf(args, sizeof args, "render '%s' --size 40x30 --spp 7 --resume '%s' -o '%s'",
+             cornell(), check, mine);
+    char *err = NULL;
+    assert_int_equal(run_job(3, args, &err), 0);
+    assert_non_null(strstr(err, "resumed from"));
+    free(err);
+    test_assert_same_file(one, mine);
+}
+
+static void test_zone_tracer(void **state)
+{
+    (void)state;
+    same_at_every_count("--method zone --quality 0 --size 40x30", "zone_pixel", "pfm");
+    same_at_every_count("--method zone --quality 0 --strategy zone --size 40x30", "zone_zone",
+                        "pfm");
+}
+
+/* The forest Phase One builds split over processes is the one a single
+ * process builds: read back by one process, it renders the same bytes.
+ * (The files themselves differ in the time Phase One took.) */
+static void test_zone_forest(void **state)
+{
+    (void)state;
+    char args[4096], forest[1024], a[1024], b[1024];
+    snprintf(forest, sizeof forest, "%s", test_tmp_path("job.forest"));
+    snprintf(a, sizeof a, "%s", test_tmp_path("forest_single.pfm"));
+    snprintf(b, sizeof b, "%s", test_tmp_path("forest_loaded.pfm"));
+    snprintf(args, sizeof args, "render '%s' --method zone --quality 0 --size 24x16 -q -o '%s'", cornell(),
+             a);
+    assert_int_equal(test_run_cli(args, NULL), 0);
+    snprintf(args, sizeof args, "render '%s' --method zone --quality 0 --size 24x16 --save-forest '%s' -q "
+             "-o '%s'", cornell(), forest, test_tmp_path("forest_job.pfm"));
+    assert_int_equal(run_job(3, args, NULL), 0);
+    test_assert_same_file(a, test_tmp_path("forest_job.pfm"));
+    snprintf(args, sizeof args, "render '%s' --method zone --quality 0 --size 24x16 --load-forest '%s' -q "
+             "-o '%s'", cornell(), forest, b);
+    assert_int_equal(test_run_cli(args, NULL), 0);
+    test_assert_same_file(a, b);
+}
+
+static void test_animation(void **state)
+{
+    (void)state;
+    const char *motions = test_write_file("job_motions.json",
+        "{\"motions\": [{\"thing\": 0, \"type\": \"orbiting\", \"axis\": \"y\", \"period\": 4},"
+        " {\"light\": 0, \"type\": \"brownian\", \"scale\": 0.2}]}\n");
+    char options[2048];
+    snprintf(options, sizeof options, "--motions '%s' --frames 5 --fps 2 --size 24x16 --spp 2",
+             motions);
+    char args[4096];
+    snprintf(args, sizeof args, "render '%s' %s -q -o '%s/anim_single_%%d.pfm'", cornell(),
+             options, test_tmp_dir());
+    assert_int_equal(test_run_cli(args, NULL), 0);
+    for (int ranks = 2; ranks <= 3; ranks++) {
+        snprintf(args, sizeof args, "render '%s' %s --threads 1 -q -o '%s/anim_%d_%%d.pfm'",
+                 cornell(), options, test_tmp_dir(), ranks);
+        assert_int_equal(run_job(ranks, args, NULL), 0);
+        for (int k = 0; k < 5; k++) {
+            char a[1024], b[64];
+            snprintf(a, sizeof a, "%s/anim_single_%d.pfm", test_tmp_dir(), k);
+            snprintf(b, sizeof b, "anim_%d_%d.pfm", ranks, k);
+            test_assert_same_file(a, test_tmp_path(b));
+        }
+    }
+}
+
+static void expect_failure(int ranks, const char *args, int code, const char *needle)
+{
+    char *err = NULL;
+    int rc = run_job(ranks, args, &err);
+    if (rc != code || !err || !strstr(err, needle))
+        fail_msg("expected exit %d and \"%s\", got %d:\n%s", code, needle, rc, err ? err : "");
+    free(err);
+}
+
+/* Failures on one process only (its own arguments, in MPMD form: as when
+ * a node lacks a file or has less memory) end the whole job. */
+static void test_failures(void **state)
+{
+    (void)state;
+    char args[4096];
+    const char *out = test_tmp_path("fail.pfm");
+    /* the scene is missing on process 1 */
+    snprintf(args, sizeof args, "render '%s' --size 8x8 --spp 1 -o '%s' : -n 1 @ZT@ render "
+             "'%s/nowhere.json' --size 8x8 --spp 1 -o '%s'", cornell(), out, test_tmp_dir(), out);
+    expect_failure(1, args, 2, "process 1 of 2");
+    expect_failure(1, args, 2, "nowhere.json");
+    /* process 2 may not use the memory the render needs: it stops inside
+     * the render, where the others wait for it */
+    snprintf(args, sizeof args, "render '%s' --size 64x64 --spp 100000 -o '%s' : -n 1 @ZT@ "
+             "render '%s' --size 64x64 --spp 100000 --max-memory 1K -o '%s'", cornell(), out,
+             cornell(), out);
+    expect_failure(2, args, 5, "more than the limit");
+    /* the output cannot be written (rank 0 checks before the work) */
+    snprintf(args, sizeof args, "render '%s' --size 8x8 --spp 1 -o '%s/no/such/dir/x.pfm'",
+             cornell(), test_tmp_dir());
+    expect_failure(2, args, 4, "not writable");
+    /* the same bad option everywhere: one message, exit 1 */
+    snprintf(args, sizeof args, "render '%s' --spp 0", cornell());
+    char *err = NULL;
+    assert_int_equal(run_job(3, args, &err), 1);
+    const char *first = strstr(err, "--spp");
+    assert_non_null(first);
+    assert_null(strstr(first + 1, "zonetrace: --spp")); /* printed once */
+    free(err);
+}
+
+int main(void)
+{
+    /* Open MPI refuses root without these, and in containers its shared
+     * memory transport cannot use cross-process copies. */
+    setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+    setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+    setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 1);
+    /* Under the sanitizers the processes of a job keep ASan and UBSan but
+     * not the leak check: Open MPI's plugins leave allocations behind at
+     * exit in code already unloaded, which no suppression can name.  The
+     * other tests check the program's own leaks. */
+    const char *asan = getenv("ASAN_OPTIONS");
+    if (asan) {
+        char options[1024];
+        snprintf(options, sizeof options, "%s:detect_leaks=0", asan);
+        setenv("ASAN_OPTIONS", options, 1);
+    }
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_path_tracer),
+        cmocka_unit_test(test_path_resumed),
+        cmocka_unit_test(test_zone_tracer),
+        cmocka_unit_test(test_zone_forest),
+        cmocka_unit_test(test_animation),
+        cmocka_unit_test(test_failures),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
+
+#else /* a build without MPI */
+
+static void test_refuses_mpirun(void **state)
+{
+    (void)state;
+    char args[1024], *err = NULL;
+    snprintf(args, sizeof args, "render '%s/scenes/cornell.json' --spp 1 -o '%s'",
+             ZT_SOURCE_DIR, test_tmp_path("x.pfm"));
+    setenv("OMPI_COMM_WORLD_SIZE", "2", 1);
+    int rc = test_run_cli(args, &err);
+    unsetenv("OMPI_COMM_WORLD_SIZE");
+    assert_int_equal(rc, 6);
+    assert_non_null(strstr(err, "built without MPI"));
+    free(err);
+}
+
+int main(void)
+{
+    fprintf(stderr, "test_cluster: this build has no MPI; only its refusal under mpirun "
+            "is tested\n");
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_refuses_mpirun)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
+#endif
