@@ -190,6 +190,11 @@ static void test_failures(void **state)
              "render '%s' --size 64x64 --spp 100000 --max-memory 1K -o '%s'", cornell(), out,
              cornell(), out);
     expect_failure(2, args, 5, "more than the limit");
+    /* process 1 was given another seed (or read another version of the
+     * scene): its rows would not fit the others' */
+    snprintf(args, sizeof args, "render '%s' --size 8x8 --spp 1 -o '%s' : -n 1 @ZT@ render "
+             "'%s' --size 8x8 --spp 1 --seed 9 -o '%s'", cornell(), out, cornell(), out);
+    expect_failure(1, args, 1, "process 1 of 2 has another scene or other options");
     /* the output cannot be written (rank 0 checks before the work) */
     snprintf(args, sizeof args, "render '%s' --size 8x8 --spp 1 -o '%s/no/such/dir/x.pfm'",
              cornell(), test_tmp_dir());

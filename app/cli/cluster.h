@@ -50,4 +50,8 @@ void cluster_abort(int code, const char *message);
  * printed) when the transfer failed. */
 int cluster_gather(const void *mine, size_t bytes, void *all);
 
+/* The library's merges so far on this process: how many, their bytes, and
+ * the seconds spent in them (waiting for the other processes included). */
+void cluster_exchanges(long *count, double *bytes, double *seconds);
+
 #endif

@@ -444,6 +444,14 @@ static int render_image(render_job *job)
     if (job->verbose)
         fprintf(stderr, "memory: %.1f MiB estimated before the work (docs/long-renders.md)\n",
                 stats.memory_estimate / 1048576.0);
+    if (job->verbose && cluster_ranks() > 1) {
+        long n;
+        double bytes, seconds;
+        cluster_exchanges(&n, &bytes, &seconds);
+        fprintf(stderr, "exchanges between the %d processes: %ld, %.2f MiB, %.3f s in them on "
+                "process 0 (waiting for the others included)\n", cluster_ranks(), n,
+                bytes / 1048576.0, seconds);
+    }
     if (cluster_rank() == 0)
         cli_report_stop(&opt, &stats, job->quiet);
     return stats.stopped == ZT_STOP_INTERRUPT ? EXIT_INTERRUPTED : EXIT_OK;

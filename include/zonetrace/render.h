@@ -37,8 +37,8 @@ typedef int (*zt_progress_fn)(void *user, const char *stage, double done,
 #define ZT_MAX_LIGHTS_OFF 64
 
 /* One of several processes rendering the same scene with the same options
- * (MPI ranks: docs/cluster.md).  The work is dealt out in units (rows of
- * tiles, rows of pixels, blocks of Phase One's nodes) round-robin by rank,
+ * (MPI ranks: docs/cluster.md).  The work is dealt out in units (tiles,
+ * rows of pixels, blocks of Phase One's nodes) round-robin by rank,
  * and the processes exchange results through merge; every process ends
  * with the image, the same bit for bit as one process renders. */
 typedef struct zt_share {
@@ -108,7 +108,7 @@ typedef struct zt_render_options {
     uint64_t max_memory;
 
     /* When not NULL with ranks > 1: this process does its share of the
-     * work of zt_render (path tracer: its rows of tiles; zone tracer: its
+     * work of zt_render (path tracer: its tiles; zone tracer: its
      * blocks of nodes at every level of Phase One and its rows of Phase
      * Two) and of a zone renderer's zt_renderer_create and
      * zt_renderer_accumulate; the path tracer's zt_renderer_accumulate

@@ -6,6 +6,7 @@
  * order and gives the same bits. */
 #include <omp.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "camera/camera.h"
 #include "geom/accel.h"
@@ -17,15 +18,29 @@
 
 #define TILE 16
 
-int path_tile_row(int y)
+static int path_tile_count(int width, int height)
 {
-    return y / TILE;
+    return ((width + TILE - 1) / TILE) * ((height + TILE - 1) / TILE);
 }
 
 long long path_tiles_owned(const zt_render_options *o, int width, int height)
 {
-    long long per_row = (width + TILE - 1) / TILE;
-    return per_row * share_owned(o, (height + TILE - 1) / TILE);
+    return share_owned(o, path_tile_count(width, height));
+}
+
+void path_clear_others(const zt_render_options *o, double *sums, int width, int height)
+{
+    int tiles_x = (width + TILE - 1) / TILE, tiles = path_tile_count(width, height);
+    for (int t = 0; t < tiles; t++) {
+        if (share_owns(o, t))
+            continue;
+        int x0 = (t % tiles_x) * TILE, y0 = (t / tiles_x) * TILE;
+        int x1 = x0 + TILE < width ? x0 + TILE : width;
+        int y1 = y0 + TILE < height ? y0 + TILE : height;
+        for (int y = y0; y < y1; y++)
+            memset(sums + 3 * ((size_t)y * (size_t)width + (size_t)x0), 0,
+                   3 * (size_t)(x1 - x0) * sizeof *sums);
+    }
 }
 
 zt_status path_accumulate_into(zt_renderer *r, int first, int count, path_sums out,
@@ -58,8 +73,8 @@ zt_status path_accumulate_into(zt_renderer *r, int first, int count, path_sums o
 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays, samples)
     for (int t = 0; t < tiles; t++) {
-        /* Split over processes, each takes its rows of tiles. */
-        if (prog->cancelled || !share_owns(o, t / tiles_x))
+        /* Split over processes, each takes its tiles. */
+        if (prog->cancelled || !share_owns(o, t))
             continue;
         int x0 = (t % tiles_x) * TILE, y0 = (t / tiles_x) * TILE;
         int x1 = x0 + TILE < width ? x0 + TILE : width;

@@ -5,7 +5,6 @@
  * samples fall into passes, runs and resumptions, the bits are the same. */
 #include <math.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include "render/checkpoint.h"
 #include "render/render_internal.h"
@@ -46,18 +45,16 @@ static zt_status save(const zt_renderer *r, uint64_t key, int done, const double
                             err);
 }
 
-/* Split over processes, each holds its own rows of tiles: the others'
- * pixels are cleared (they hold an earlier merge's or a checkpoint's sums)
- * and the merge gives every process the whole image. */
+/* Split over processes, each holds its own tiles: the others' pixels are
+ * cleared (they hold an earlier merge's or a checkpoint's sums) and the
+ * merge gives every process the whole image. */
 static zt_status gather_sums(const zt_renderer *r, double *sums, zt_error *err)
 {
     const zt_render_options *o = &r->options;
     if (share_ranks(o) == 1)
         return ZT_OK;
     const int w = r->scene->camera.width, h = r->scene->camera.height;
-    for (int y = 0; y < h; y++)
-        if (!share_owns(o, path_tile_row(y)))
-            memset(sums + 3 * (size_t)y * (size_t)w, 0, 3 * (size_t)w * sizeof *sums);
+    path_clear_others(o, sums, w, h);
     return share_merge(o, sums, 3 * (size_t)w * (size_t)h * sizeof *sums, err);
 }
 

@@ -10,6 +10,7 @@
 #include "geom/accel.h"
 #include "render/memory.h"
 #include "render/render_internal.h"
+#include "render/share.h"
 #include "util/error.h"
 
 zt_render_options zt_render_options_default(void)
@@ -100,6 +101,8 @@ static zt_status renderer_create(const zt_scene *scene, const zt_render_options 
 {
     *out = NULL;
     zt_status st = check_options(scene, o, err);
+    if (st == ZT_OK)
+        st = share_check_same(scene, o, err);
     if (st != ZT_OK)
         return st;
     uint64_t need = memory_estimate_render(scene, o);

@@ -63,11 +63,11 @@ typedef struct path_sums {
 zt_status path_accumulate_into(zt_renderer *r, int first, int count, path_sums out,
                                progress *shared, zt_render_stats *stats, zt_error *err);
 
-/* The row of tiles pixel row y is in: rows of tiles are the units the
- * path tracer deals out to processes (render/share.h). */
-int path_tile_row(int y);
-/* The tiles of a width x height image this process renders in a pass. */
+/* Split over processes (render/share.h), the path tracer deals out its
+ * tiles: how many of a width x height image's are this process's, and
+ * clearing the others' pixels in sums (3 doubles a pixel). */
 long long path_tiles_owned(const zt_render_options *o, int width, int height);
+void path_clear_others(const zt_render_options *o, double *sums, int width, int height);
 
 /* zt_render's path tracer (passes.c): passes until spp, the time limit or
  * a stop, with checkpoints; t0 is when zt_render began. */

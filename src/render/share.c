@@ -4,7 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/checkpoint.h"
 #include "util/error.h"
+#include "util/fnv1a.h"
 
 int share_ranks(const zt_render_options *o)
 {
@@ -75,4 +77,33 @@ zt_status share_max(const zt_render_options *o, double *x, int n, zt_error *err)
 zt_status share_sum(const zt_render_options *o, double *x, int n, zt_error *err)
 {
     return combine(o, x, n, 1, err);
+}
+
+zt_status share_check_same(const zt_scene *scene, const zt_render_options *o, zt_error *err)
+{
+    int ranks = share_ranks(o);
+    if (ranks == 1)
+        return ZT_OK;
+    /* What the image depends on: the scene, camera, seed, levels and
+     * lights-off (as a checkpoint's key) and the renderer's settings. */
+    fnv1a h = {FNV1A_START};
+    fnv_u64(&h, checkpoint_key(scene, o));
+    fnv_i32(&h, (int)o->method);
+    fnv_i32(&h, o->spp);
+    fnv_i32(&h, o->quality);
+    fnv_i32(&h, (int)o->strategy);
+    fnv_f64(&h, o->cutoff);
+    fnv_i32(&h, o->resume);
+    double mine[2] = {(double)(h.h >> 32), (double)(h.h & 0xffffffffu)};
+    double *all = malloc(2 * (size_t)ranks * sizeof *all);
+    if (!all)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    zt_status st = share_all(o, mine, 2, all, err);
+    for (int k = 1; st == ZT_OK && k < ranks; k++)
+        if (all[2 * k] != all[0] || all[2 * k + 1] != all[1])
+            st = zt_fail(err, ZT_ERR_ARGUMENT, "process %d of %d has another scene or other "
+                         "options than process 0: every process must read the same files "
+                         "with the same options", k, ranks);
+    free(all);
+    return st;
 }

@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "zonetrace/render.h"
+#include "zonetrace/scene.h"
 
 int share_ranks(const zt_render_options *o);
 int share_rank(const zt_render_options *o);
@@ -30,5 +31,10 @@ zt_status share_all(const zt_render_options *o, const double *mine, int n, doubl
  * set), or their sum. */
 zt_status share_max(const zt_render_options *o, double *x, int n, zt_error *err);
 zt_status share_sum(const zt_render_options *o, double *x, int n, zt_error *err);
+
+/* Fails (on every process alike) unless all processes render the same
+ * scene, camera and options: files that differ between nodes would give an
+ * image of parts that do not fit. */
+zt_status share_check_same(const zt_scene *scene, const zt_render_options *o, zt_error *err);
 
 #endif

@@ -18,6 +18,8 @@ static zt_share share;
 static char note[ZT_ERROR_MESSAGE_MAX];
 static int saved_stderr = -1; /* rank > 0: the real stderr, for cluster_abort */
 static char library[MPI_MAX_LIBRARY_VERSION_STRING + 64];
+static long merges;
+static double merged_bytes, merge_seconds;
 
 /* Whether mpirun (Open MPI, or a PMI launcher such as MPICH's or Slurm's)
  * started this process as one of several. */
@@ -36,6 +38,9 @@ static int launched(void)
 static int merge(void *user, void *buffer, size_t bytes)
 {
     (void)user;
+    double t0 = MPI_Wtime();
+    merges++;
+    merged_bytes += (double)bytes;
     unsigned char *p = buffer;
     const size_t chunk = (size_t)1 << 27; /* 64-bit words: 1 GiB */
     size_t words = bytes / 8;
@@ -49,7 +54,15 @@ static int merge(void *user, void *buffer, size_t bytes)
     if (tail && MPI_Allreduce(MPI_IN_PLACE, p + 8 * words, (int)tail, MPI_UNSIGNED_CHAR,
                               MPI_BOR, MPI_COMM_WORLD) != MPI_SUCCESS)
         return -1;
+    merge_seconds += MPI_Wtime() - t0;
     return 0;
+}
+
+void cluster_exchanges(long *count, double *bytes, double *seconds)
+{
+    *count = merges;
+    *bytes = merged_bytes;
+    *seconds = merge_seconds;
 }
 
 int cluster_start(int *argc, char ***argv)
