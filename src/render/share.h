@@ -13,7 +13,8 @@ int share_ranks(const zt_render_options *o);
 int share_rank(const zt_render_options *o);
 
 /* Whether work unit `unit` (0, 1, 2, ...) is this process's: units are
- * dealt round-robin, so neighbours, which cost alike, are spread out. */
+ * dealt out by a hash of their number, so neighbours, which cost alike,
+ * are spread over the processes, and each gets about 1/ranks of them. */
 int share_owns(const zt_render_options *o, long long unit);
 
 /* How many of units 0 .. count-1 are this process's. */

@@ -138,8 +138,12 @@ static int straight(const surface_nodes *sn, const float *v, const int32_t line[
     return 1;
 }
 
-/* Nodes are dealt to processes in blocks this long (render/share.h). */
+/* Threads take nodes in chunks this long, and check the clock once a
+ * chunk. */
 #define NODE_BLOCK 64
+/* Processes take nodes in blocks this long (render/share.h): short, since
+ * the costly nodes (shadow edges, corners) lie together. */
+#define SHARE_BLOCK 8
 
 /* E_level at every live node, added to what is there (caustics).  Coarse
  * nodes first; a finer node midway between coarser ones on a straight
@@ -175,9 +179,9 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
             int q;
 #pragma omp atomic read
             q = quit;
-            if (q || !sn->live[k] || !share_owns(o, k / NODE_BLOCK))
+            if (q || !sn->live[k] || !share_owns(o, k / SHARE_BLOCK))
                 continue;
-            if (k % NODE_BLOCK == 0 && (render_clock() > until || (stop && *stop))) {
+            if (k % NODE_BLOCK < SHARE_BLOCK && (render_clock() > until || (stop && *stop))) {
 #pragma omp atomic write
                 quit = 1;
                 continue;
