@@ -137,6 +137,31 @@ static void test_zone_forest(void **state)
     test_assert_same_file(a, b);
 }
 
+/* Limits are agreed: a zone render whose time is up before level 0 ends
+ * stops at depth 1 on every process, and writes the depth-1 image; a path
+ * render stops at a pass all processes reached. */
+static void test_time_limit(void **state)
+{
+    (void)state;
+    char args[4096], *err = NULL;
+    snprintf(args, sizeof args, "render '%s' --method zone --quality 4 --depth 1 --size 40x30 "
+             "-q -o '%s'", cornell(), test_tmp_path("depth1_single.pfm"));
+    assert_int_equal(test_run_cli(args, NULL), 0);
+    snprintf(args, sizeof args, "render '%s' --method zone --quality 4 --size 40x30 "
+             "--time-limit 0.001 -o '%s'", cornell(), test_tmp_path("depth1_job.pfm"));
+    assert_int_equal(run_job(2, args, &err), 0);
+    assert_non_null(strstr(err, "reached depth 1 of 3"));
+    free(err);
+    char a[1024];
+    snprintf(a, sizeof a, "%s", test_tmp_path("depth1_single.pfm"));
+    test_assert_same_file(a, test_tmp_path("depth1_job.pfm"));
+    snprintf(args, sizeof args, "render '%s' --size 64x64 --spp 1000000 --time-limit 1 -o '%s'",
+             cornell(), test_tmp_path("limited.pfm"));
+    assert_int_equal(run_job(2, args, &err), 0);
+    assert_non_null(strstr(err, "stopped by the time limit"));
+    free(err);
+}
+
 static void test_animation(void **state)
 {
     (void)state;
@@ -231,6 +256,7 @@ int main(void)
         cmocka_unit_test(test_path_resumed),
         cmocka_unit_test(test_zone_tracer),
         cmocka_unit_test(test_zone_forest),
+        cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_animation),
         cmocka_unit_test(test_failures),
     };
