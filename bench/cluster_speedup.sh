@@ -18,8 +18,8 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_btl_vader_single_copy_mechanism=none
-# mpirun's default binding: each process on a core of its own (without
-# it, the two processes were seen sharing a core for a second of five).
+# mpirun's default binding: each process on a core of its own (unbound,
+# two processes here waited over a second of five for each other).
 mpi="mpirun --oversubscribe"
 
 path="render $scene --spp 64 --threads 1 -q"

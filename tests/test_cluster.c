@@ -124,15 +124,15 @@ static void test_zone_forest(void **state)
     snprintf(forest, sizeof forest, "%s", test_tmp_path("job.forest"));
     snprintf(a, sizeof a, "%s", test_tmp_path("forest_single.pfm"));
     snprintf(b, sizeof b, "%s", test_tmp_path("forest_loaded.pfm"));
-    snprintf(args, sizeof args, "render '%s' --method zone --quality 0 --size 24x16 -q -o '%s'", cornell(),
-             a);
+    snprintf(args, sizeof args, "render '%s' --method zone --quality 0 --size 24x16 -q -o '%s'",
+             cornell(), a);
     assert_int_equal(test_run_cli(args, NULL), 0);
-    snprintf(args, sizeof args, "render '%s' --method zone --quality 0 --size 24x16 --save-forest '%s' -q "
-             "-o '%s'", cornell(), forest, test_tmp_path("forest_job.pfm"));
+    snprintf(args, sizeof args, "render '%s' --method zone --quality 0 --size 24x16 "
+             "--save-forest '%s' -q -o '%s'", cornell(), forest, test_tmp_path("forest_job.pfm"));
     assert_int_equal(run_job(3, args, NULL), 0);
     test_assert_same_file(a, test_tmp_path("forest_job.pfm"));
-    snprintf(args, sizeof args, "render '%s' --method zone --quality 0 --size 24x16 --load-forest '%s' -q "
-             "-o '%s'", cornell(), forest, b);
+    snprintf(args, sizeof args, "render '%s' --method zone --quality 0 --size 24x16 "
+             "--load-forest '%s' -q -o '%s'", cornell(), forest, b);
     assert_int_equal(test_run_cli(args, NULL), 0);
     test_assert_same_file(a, b);
 }
@@ -188,12 +188,16 @@ static void test_animation(void **state)
     }
 }
 
-static void expect_failure(int ranks, const char *args, int code, const char *needle)
+/* The job ends with code, and its messages hold needle (and `also` when it
+ * is not NULL). */
+static void expect_failure(int ranks, const char *args, int code, const char *needle,
+                           const char *also)
 {
     char *err = NULL;
     int rc = run_job(ranks, args, &err);
-    if (rc != code || !err || !strstr(err, needle))
-        fail_msg("expected exit %d and \"%s\", got %d:\n%s", code, needle, rc, err ? err : "");
+    if (rc != code || !err || !strstr(err, needle) || (also && !strstr(err, also)))
+        fail_msg("expected exit %d and \"%s\"%s%s, got %d:\n%s", code, needle,
+                 also ? " and " : "", also ? also : "", rc, err ? err : "");
     free(err);
 }
 
@@ -207,23 +211,22 @@ static void test_failures(void **state)
     /* the scene is missing on process 1 */
     snprintf(args, sizeof args, "render '%s' --size 8x8 --spp 1 -o '%s' : -n 1 @ZT@ render "
              "'%s/nowhere.json' --size 8x8 --spp 1 -o '%s'", cornell(), out, test_tmp_dir(), out);
-    expect_failure(1, args, 2, "process 1 of 2");
-    expect_failure(1, args, 2, "nowhere.json");
+    expect_failure(1, args, 2, "process 1 of 2", "nowhere.json");
     /* process 2 may not use the memory the render needs: it stops inside
      * the render, where the others wait for it */
     snprintf(args, sizeof args, "render '%s' --size 64x64 --spp 100000 -o '%s' : -n 1 @ZT@ "
              "render '%s' --size 64x64 --spp 100000 --max-memory 1K -o '%s'", cornell(), out,
              cornell(), out);
-    expect_failure(2, args, 5, "more than the limit");
+    expect_failure(2, args, 5, "more than the limit", NULL);
     /* process 1 was given another seed (or read another version of the
      * scene): its rows would not fit the others' */
     snprintf(args, sizeof args, "render '%s' --size 8x8 --spp 1 -o '%s' : -n 1 @ZT@ render "
              "'%s' --size 8x8 --spp 1 --seed 9 -o '%s'", cornell(), out, cornell(), out);
-    expect_failure(1, args, 1, "process 1 of 2 has another scene or other options");
+    expect_failure(1, args, 1, "process 1 of 2 has another scene or other options", NULL);
     /* the output cannot be written (rank 0 checks before the work) */
     snprintf(args, sizeof args, "render '%s' --size 8x8 --spp 1 -o '%s/no/such/dir/x.pfm'",
              cornell(), test_tmp_dir());
-    expect_failure(2, args, 4, "not writable");
+    expect_failure(2, args, 4, "not writable", NULL);
     /* the same bad option everywhere: one message, exit 1 */
     snprintf(args, sizeof args, "render '%s' --spp 0", cornell());
     char *err = NULL;

@@ -73,9 +73,9 @@ static zt_status resume(const zt_renderer *r, uint64_t key, double *sums, int *d
         return st;
     /* Rank 0's status and count; the others' are 0. */
     double told[2] = {st, *done};
-    zt_error ex;
-    if (share_max(o, told, 2, &ex) != ZT_OK)
-        return zt_fail(err, ex.status, "%s", ex.message);
+    zt_status exchanged = share_max(o, told, 2, err);
+    if (exchanged != ZT_OK)
+        return exchanged;
     if (told[0] != ZT_OK)
         return st != ZT_OK ? st
                            : zt_fail(err, (zt_status)told[0], "the checkpoint '%s' could not "

@@ -24,8 +24,8 @@ int share_owns(const zt_render_options *o, long long unit)
     int n = share_ranks(o);
     if (n == 1)
         return 1;
-    /* Scrambled, not unit mod n: a grid's costly nodes can fall with a
-     * period that a plain deal would hand to one process every time. */
+    /* Scrambled, not unit mod n: with mod n, a cost that repeats every
+     * n units would land on one process. */
     uint64_t h = (uint64_t)unit * 0x9e3779b97f4a7c15ULL;
     return (int)((h >> 32) % (uint64_t)n) == share_rank(o);
 }

@@ -179,13 +179,15 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
             int q;
 #pragma omp atomic read
             q = quit;
-            if (q || !sn->live[k] || !share_owns(o, k / SHARE_BLOCK))
+            if (q)
                 continue;
-            if (k % NODE_BLOCK < SHARE_BLOCK && (render_clock() > until || (stop && *stop))) {
+            if (k % NODE_BLOCK == 0 && (render_clock() > until || (stop && *stop))) {
 #pragma omp atomic write
                 quit = 1;
                 continue;
             }
+            if (!sn->live[k] || !share_owns(o, k / SHARE_BLOCK))
+                continue;
             int32_t line[4];
             double pos[5], w = 0.5;
             int fine = surface_node_line(sn, rs, k, line, pos);

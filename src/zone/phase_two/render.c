@@ -221,8 +221,10 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
         for (int q = 0; q <= surfaces; q++)
             last[q] = -1;
         size_t total_hits = 0, total_lights = 0;
-        for (int y = 0; y < h; y++)
-            for (int x = 0; x < w && share_owns(o, y); x++) {
+        for (int y = 0; y < h; y++) {
+            if (!share_owns(o, y))
+                continue;
+            for (int x = 0; x < w; x++) {
                 p2_pixel px;
                 p2_row_pixel(&rows[y], x, y, &px);
                 int pi = y * w + x;
@@ -246,6 +248,7 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
                     total_lights++;
                 }
             }
+        }
         if (pass == 0) {
             for (int q = 0; q <= surfaces; q++)
                 hit_first[q + 1] += hit_first[q];
@@ -311,8 +314,9 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
         goto done;
     }
     for (int y = 0; y < h; y++)
-        for (int x = 0; x < w && share_owns(o, y); x++)
-            add_to_image(sum, x, y, acc + ((size_t)y * w + x) * 3);
+        if (share_owns(o, y))
+            for (int x = 0; x < w; x++)
+                add_to_image(sum, x, y, acc + ((size_t)y * w + x) * 3);
 
 done:
     if (rows)
