@@ -60,6 +60,7 @@ typedef struct p2_row {
     size_t *light_first;        /* width + 1 offsets into lights */
     uint32_t *corner;           /* scratch: corner signatures */
     int *corner_part;
+    float *corner_t;            /* their first hits' distances (-1: none) */
     int width;
 } p2_row;
 

@@ -29,6 +29,10 @@
 #define FINE_SHADE 16  /* and its shaded samples per side */
 #define SEEN_MAX 8     /* light parts listed per pixel */
 #define CURVED_GRID 2  /* sub-pixel grid of smooth pixels that see a sphere */
+/* and of those that see a mesh triangle thinner than the pixel's
+ * footprint: one mesh is one signature, so its own sub-pixel detail (a
+ * stack of fins) shows no edge, and one sample catches or misses it. */
+#define DETAIL_GRID 2
 /* Specular steps a signature follows.  Fixed, not the render's depth: the
  * images of levels 0..D must use the same samples as the depth-D image,
  * or they would not add up to it. */
@@ -345,9 +349,37 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
     return 1;
 }
 
+/* Whether a pixel that sees one mesh may hold its sub-pixel detail: the
+ * distances at its corners and sample spread by more than DETAIL_STEPS
+ * times the pixel's width there, as where a stack of fins shows its gaps
+ * (and where a surface is tilted more than about 20 degrees from the view).
+ * On the engine room's level 1 at 512 x 512 against a 512-spp path image:
+ * 3 pixel widths 9.1% per pixel, 1 width 7.4%, half a width 4.3% (0.96%
+ * over 4 x 4 blocks; without the test 12.1%), for 5.3 s against 4.0 s. */
+#define DETAIL_STEPS 0.5f
+static int fine_detail(const p2_ctx *c, const float ct[4], const p2_sample *s, size_t n)
+{
+    const rscene *rs = &c->r->rs;
+    if (n == 0 || s[0].part < rs->part_count)
+        return 0;
+    /* The pixel's angular width: its width on the screen over the screen's
+     * distance from the viewpoint. */
+    vec3f mid = f3_add(c->c.to_screen, f3_scale(f3_add(c->c.right, c->c.down), 0.5f));
+    float dist = f3_length(mid);
+    float angle = f3_length(c->c.right) / (float)c->c.width / dist;
+    float lo = s[0].t, hi = s[0].t;
+    for (int k = 0; k < 4; k++) {
+        if (ct[k] < 0)
+            return 0;
+        lo = fminf(lo, ct[k]);
+        hi = fmaxf(hi, ct[k]);
+    }
+    return hi - lo > DETAIL_STEPS * angle * (s[0].t + dist);
+}
+
 /* The samples of pixel (px, py) given its corner signatures. */
 static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners[4],
-                         seen_lights *lights, p2_row *row, edge_grid **scratch, uint64_t *rays)
+                         const float ct[4], seen_lights *lights, p2_row *row, edge_grid **scratch, uint64_t *rays)
 {
     int g = c->g;
     uint32_t first = corners[0];
@@ -378,6 +410,12 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
          * faster than one sample can tell. */
         row->sample_count = start;
         if (!grid_samples(c, px, py, CURVED_GRID, first, lights, row, rays, &edge, &curved))
+            return 0;
+    }
+    if (!edge && !marked && g < DETAIL_GRID &&
+        fine_detail(c, ct, row->samples + start, row->sample_count - start)) {
+        row->sample_count = start;
+        if (!grid_samples(c, px, py, DETAIL_GRID, first, lights, row, rays, &edge, &curved))
             return 0;
     }
     if (!edge && !marked)
@@ -416,7 +454,9 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         row->light_first = malloc((size_t)w1 * sizeof *row->light_first);
         row->corner = malloc(2 * (size_t)w1 * sizeof *row->corner);
         row->corner_part = malloc(2 * (size_t)w1 * sizeof *row->corner_part);
-        if (!row->pixel_first || !row->light_first || !row->corner || !row->corner_part)
+        row->corner_t = malloc(2 * (size_t)w1 * sizeof *row->corner_t);
+        if (!row->pixel_first || !row->light_first || !row->corner || !row->corner_part ||
+            !row->corner_t)
             return 0;
     }
     row->sample_count = 0;
@@ -431,6 +471,7 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         cam_ray(&c->c, (float)(k % w1), (float)(y + k / w1), &org, &dir);
         row->corner[k] = ray_signature(rs, org, dir, rays, &h, NULL, NULL);
         row->corner_part[k] = h.part;
+        row->corner_t[k] = h.part < 0 ? -1.0f : h.t;
     }
     for (int x = 0; x < w; x++) {
         uint32_t cs[4] = {row->corner[x], row->corner[x + 1], row->corner[w1 + x],
@@ -448,7 +489,9 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         }
         row->pixel_first[x] = row->sample_count;
         row->light_first[x] = row->light_count;
-        if (!pixel_samples(c, x, y, cs, &lights, row, &scratch, rays) ||
+        const float ct[4] = {row->corner_t[x], row->corner_t[x + 1], row->corner_t[w1 + x],
+                             row->corner_t[w1 + x + 1]};
+        if (!pixel_samples(c, x, y, cs, ct, &lights, row, &scratch, rays) ||
             !push_lights(row, &lights)) {
             free(scratch);
             return 0;
@@ -469,5 +512,6 @@ void p2_row_free(p2_row *row)
     free(row->light_first);
     free(row->corner);
     free(row->corner_part);
+    free(row->corner_t);
     memset(row, 0, sizeof *row);
 }
