@@ -77,6 +77,9 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
     c.r = r;
     c.f = f;
     cam_init(&c.c, &r->scene->camera);
+    vec3f mid = f3_add(c.c.to_screen, f3_scale(f3_add(c.c.right, c.c.down), 0.5f));
+    c.screen_dist = f3_length(mid);
+    c.pixel_angle = f3_length(c.c.right) / (float)c.c.width / c.screen_dist;
     c.lo = o->level >= 0 ? o->level : 0;
     c.hi = o->level >= 0 ? o->level : o->depth;
     c.g = f->q.aa;

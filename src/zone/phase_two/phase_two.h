@@ -108,6 +108,10 @@ typedef struct p2_ctx {
     cam c;
     int lo, hi;         /* levels rendered */
     int g;              /* sub-pixel grid of smooth pixels */
+    /* A pixel's angular width (its width on the screen over the screen's
+     * distance from the viewpoint) and that distance: a pixel is
+     * pixel_angle x (t + screen_dist) wide at a hit t beyond the screen. */
+    float pixel_angle, screen_dist;
     p2_terms terms;
     const struct p2_marks *marks; /* what the pixels' own rays may miss */
 } p2_ctx;
