@@ -116,20 +116,16 @@ typedef struct walk {
     int32_t id;
 } walk;
 
-/* Vertex v's supports: vertices of rounds before r reached from v along
- * the mesh's edges through vertices within `reach` of v facing its way, so
- * on its own sheet of surface (a crease or a gap between two fins breaks
- * the walk); the nearest in each of SECTORS directions around v, written
- * to out.  Returns how many, 0 when they do not surround v. */
-static int find_supports(const adjacency *adj, const float *pos, const float *nrm,
-                         const uint8_t *live, const uint8_t *assigned, int32_t base, int32_t v,
-                         int r, double reach, walk *w, int32_t *out)
+/* The vertices reached from v along the mesh's edges through vertices
+ * within `reach` of v facing its way (normals within acos(SAME_NORMAL)):
+ * v's own sheet of surface, which a crease or the gap between two fins
+ * ends.  They are left in w->queue[1 ..], v first; returns their count
+ * with v, or -1 as soon as it meets a vertex that `taken` marks (not 0xff;
+ * NULL: none). */
+static int walk_sheet(const adjacency *adj, const float *pos, const float *nrm, int32_t v,
+                      double reach, const uint8_t *taken, walk *w)
 {
     const float *p = pos + 3 * (size_t)v, *n = nrm + 3 * (size_t)v;
-    double t[3], b[3];
-    tangents(n, t, b);
-    cand c[SECTORS];
-    int filled[SECTORS] = {0};
     int head = 0, tail = 0;
     w->id++;
     w->stamp[v] = w->id;
@@ -141,26 +137,49 @@ static int find_supports(const adjacency *adj, const float *pos, const float *nr
             if (w->stamp[x] == w->id)
                 continue;
             w->stamp[x] = w->id;
-            const float *q = pos + 3 * (size_t)x, *m = nrm + 3 * (size_t)x;
-            double d2 = dist2(q, p);
-            if (d2 > reach * reach || dotf(n, m) < SAME_NORMAL)
+            if (dist2(pos + 3 * (size_t)x, p) > reach * reach ||
+                dotf(n, nrm + 3 * (size_t)x) < SAME_NORMAL)
                 continue;
+            if (taken && taken[x] != 0xff)
+                return -1;
             w->queue[tail++] = x;
-            if (assigned[x] >= r || !live[base + x] || !(d2 > 0))
-                continue;
-            float d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-            double dl = sqrt(d2);
-            if (fabs(dotf(n, d)) > FLAT * dl || fabs(dotf(m, d)) > FLAT * dl)
-                continue;
-            double angle = atan2(d[0] * b[0] + d[1] * b[1] + d[2] * b[2],
-                                 d[0] * t[0] + d[1] * t[1] + d[2] * t[2]);
-            int s = (int)floor((angle + PI) / (2 * PI) * SECTORS);
-            s = s < 0 ? 0 : s >= SECTORS ? SECTORS - 1 : s;
-            cand k = {d2, angle, x};
-            if (!filled[s] || by_distance(&k, &c[s]) < 0)
-                c[s] = k;
-            filled[s] = 1;
         }
+    }
+    return tail;
+}
+
+/* Vertex v's supports: vertices of rounds before r on its sheet within
+ * `reach`, near its tangent plane, the nearest in each of SECTORS
+ * directions around v, written to out.  Returns how many, 0 when they do
+ * not surround v. */
+static int find_supports(const adjacency *adj, const float *pos, const float *nrm,
+                         const uint8_t *live, const uint8_t *assigned, int32_t base, int32_t v,
+                         int r, double reach, walk *w, int32_t *out)
+{
+    const float *p = pos + 3 * (size_t)v, *n = nrm + 3 * (size_t)v;
+    double t[3], b[3];
+    tangents(n, t, b);
+    cand c[SECTORS];
+    int filled[SECTORS] = {0};
+    int reached = walk_sheet(adj, pos, nrm, v, reach, NULL, w);
+    for (int j = 1; j < reached; j++) {
+        int32_t x = w->queue[j];
+        const float *q = pos + 3 * (size_t)x, *m = nrm + 3 * (size_t)x;
+        double d2 = dist2(q, p);
+        if (assigned[x] >= r || !live[base + x] || !(d2 > 0))
+            continue;
+        float d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        double dl = sqrt(d2);
+        if (fabs(dotf(n, d)) > FLAT * dl || fabs(dotf(m, d)) > FLAT * dl)
+            continue;
+        double angle = atan2(d[0] * b[0] + d[1] * b[1] + d[2] * b[2],
+                             d[0] * t[0] + d[1] * t[1] + d[2] * t[2]);
+        int s = (int)floor((angle + PI) / (2 * PI) * SECTORS);
+        s = s < 0 ? 0 : s >= SECTORS ? SECTORS - 1 : s;
+        cand k = {d2, angle, x};
+        if (!filled[s] || by_distance(&k, &c[s]) < 0)
+            c[s] = k;
+        filled[s] = 1;
     }
     cand taken[SECTORS];
     int nt = 0;
@@ -180,32 +199,11 @@ static int find_supports(const adjacency *adj, const float *pos, const float *nr
     return nt;
 }
 
-/* Whether a vertex already taken lies within r of v on its sheet (the
- * walk of find_supports). */
-static int crowded_walk(const adjacency *adj, const float *pos, const float *nrm,
-                        const uint8_t *assigned, int32_t v, double r, walk *w)
+/* Whether a vertex already taken lies within r of v on its sheet. */
+static int crowded(const adjacency *adj, const float *pos, const float *nrm,
+                   const uint8_t *assigned, int32_t v, double r, walk *w)
 {
-    const float *p = pos + 3 * (size_t)v, *n = nrm + 3 * (size_t)v;
-    int head = 0, tail = 0;
-    w->id++;
-    w->stamp[v] = w->id;
-    w->queue[tail++] = v;
-    while (head < tail) {
-        int32_t u = w->queue[head++];
-        for (int32_t i = adj->first[u]; i < adj->first[u + 1]; i++) {
-            int32_t x = adj->list[i];
-            if (w->stamp[x] == w->id)
-                continue;
-            w->stamp[x] = w->id;
-            if (dist2(pos + 3 * (size_t)x, p) >= r * r ||
-                dotf(n, nrm + 3 * (size_t)x) < SAME_NORMAL)
-                continue;
-            if (assigned[x] != 0xff)
-                return 1;
-            w->queue[tail++] = x;
-        }
-    }
-    return 0;
+    return walk_sheet(adj, pos, nrm, v, r, assigned, w) < 0;
 }
 
 /* One side of one mesh: nodes base .. base + count - 1. */
@@ -228,7 +226,7 @@ static int build_side(mesh_rounds *mr, const surface_nodes *sn, const mesh *m, i
     for (int r = 0; r < ROUNDS - 1 && ok; r++, spacing *= 0.5)
         for (int32_t v = 0; v < count; v++)
             if (assigned[v] == 0xff && sn->live[base + v] &&
-                !crowded_walk(&adj, pos, nrm, assigned, v, spacing, &w0))
+                !crowded(&adj, pos, nrm, assigned, v, spacing, &w0))
                 assigned[v] = (uint8_t)r;
     free(w0.stamp);
     free(w0.queue);
