@@ -2,6 +2,7 @@
 #include "zone/transfer/cut.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "geom/accel.h"
@@ -50,6 +51,19 @@ static float lumf(const float v[3])
     return 0.2126f * v[0] + 0.7152f * v[1] + 0.0722f * v[2];
 }
 
+/* Whether element e's sending side faces the receiver (an element facing
+ * away is hidden by its own surface, whatever its cluster does). */
+static int faces(const gather *g, const sender_elem *e)
+{
+    static int facing_only = -1;
+    if (facing_only < 0)
+        facing_only = getenv("ZT_FACING") != NULL;
+    if (!facing_only)
+        return 1;
+    return e->n[0] * (g->xf.x - e->c[0]) + e->n[1] * (g->xf.y - e->c[1]) +
+               e->n[2] * (g->xf.z - e->c[2]) > 0;
+}
+
 /* The share of a cluster's power a ray reaches: rays to its two children's
  * representatives (or its elements' centres), weighted by their power, so
  * that a cluster half hidden counts about half; one ray to its own
@@ -61,11 +75,15 @@ static double seen_share(gather *g, const sender_node *node)
     const sender_tree *t = g->t;
     double seen = 0, wsum = 0;
     if (node->count > 0) {
-        int first = -1 - node->left;
+        int first = -1 - node->left, any = 0;
+        for (int i = first; i < first + node->count; i++)
+            any |= faces(g, &t->elems[i]);
         for (int i = first; i < first + node->count; i++) {
             const float *b = &t->elem_radiance[3 * (size_t)i];
             double w = (0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2]) * t->elems[i].area;
             const float *c = t->elems[i].c;
+            if (any && !faces(g, &t->elems[i]))
+                continue;
             wsum += w;
             if (w > 0)
                 seen += w * cut_visible(g->rs, g->xo, v3(c[0], c[1], c[2]), t->elems[i].background,
@@ -92,8 +110,19 @@ static double seen_share(gather *g, const sender_node *node)
             memcpy(kids, next, (size_t)nn * sizeof *kids);
             nk = nn;
         }
+        /* A representative facing away from the receiver is hidden by
+         * its own surface, whatever the rest of its cluster does: only
+         * those facing it vote (all, when none does). */
+        int facing[2 << SEEN_DEPTH], any = 0;
         for (int k = 0; k < nk; k++) {
             const sender_light *cl = &t->light[kids[k]];
+            facing[k] = faces(g, &t->elems[cl->rep_elem]);
+            any |= facing[k] && cl->power > 0;
+        }
+        for (int k = 0; k < nk; k++) {
+            const sender_light *cl = &t->light[kids[k]];
+            if (any && !facing[k])
+                continue;
             wsum += cl->power;
             if (cl->power > 0)
                 seen += cl->power * cut_visible(g->rs, g->xo, v3(cl->rep[0], cl->rep[1], cl->rep[2]),

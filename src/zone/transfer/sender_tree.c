@@ -475,11 +475,13 @@ static void fill_node(sender_tree *t, int32_t ni)
         }
         for (int a = 0; a < 3; a++)
             l->rep[a] = t->elems[best].c[a];
+        l->rep_elem = best;
     } else {
         const sender_light *L = &t->light[node->left], *R = &t->light[node->left + 1];
         const sender_light *pick = R->power > L->power ? R : L;
         for (int a = 0; a < 3; a++)
             l->rep[a] = pick->rep[a];
+        l->rep_elem = pick->rep_elem;
     }
 }
 

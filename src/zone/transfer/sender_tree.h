@@ -68,6 +68,7 @@ typedef struct sender_light {
      * Visibility is tested there, not at the centroid, which may lie
      * inside an object the cluster's elements surround. */
     float rep[3];
+    int32_t rep_elem;   /* the element rep is the centre of */
 } sender_light;
 
 typedef struct sender_tree {
