@@ -2,7 +2,6 @@
 #include "zone/transfer/cut.h"
 
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "geom/accel.h"
@@ -55,11 +54,6 @@ static float lumf(const float v[3])
  * away is hidden by its own surface, whatever its cluster does). */
 static int faces(const gather *g, const sender_elem *e)
 {
-    static int facing_only = -1;
-    if (facing_only < 0)
-        facing_only = getenv("ZT_FACING") != NULL;
-    if (!facing_only)
-        return 1;
     return e->n[0] * (g->xf.x - e->c[0]) + e->n[1] * (g->xf.y - e->c[1]) +
                e->n[2] * (g->xf.z - e->c[2]) > 0;
 }
