@@ -274,7 +274,6 @@ int mesh_rounds_build(mesh_rounds *mr, const surface_nodes *sn, const rscene *rs
     if (!any)
         return 1;
     size_t nc = (size_t)sn->node_count;
-    mr->node_count = sn->node_count;
     mr->round = calloc(nc + 1, 1);
     mr->first = calloc(nc + 1, sizeof *mr->first);
     int32_t *slots = malloc((nc + 1) * SECTORS * sizeof *slots);

@@ -23,10 +23,9 @@
 #define MESH_ROUNDS 8
 
 typedef struct mesh_rounds {
-    int node_count;
     uint8_t *round;     /* per node: 0 (computed) or the round it is read
                            in; 0 for every node that is not a mesh's vertex */
-    int32_t *first;     /* node_count + 1: node k's supports are
+    int32_t *first;     /* nodes + 1: node k's supports are
                            support[first[k] .. first[k + 1] - 1] */
     int32_t *support;
 } mesh_rounds;
