@@ -143,6 +143,11 @@ typedef struct zt_render_stats {
     uint64_t zones_pruned;
     uint64_t zones_per_level[32];
     uint64_t memory_bytes;
+    uint64_t cuts;         /* zone, Phase One: transfer cuts made (0 when
+                              the forest was read from a file) */
+    uint64_t cuts_capped;  /* of which reached the cluster limit: the rest
+                              of their light is estimated more coarsely
+                              (docs/zone-tracer.md) */
     int forest_loaded;     /* zone: the forest came from options.forest_file
                               (phase_one_seconds is then the time to read it) */
     /* zt_render */

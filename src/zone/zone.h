@@ -94,6 +94,8 @@ typedef struct zone_forest {
     int glint_count;
     vec3 *dirs;         /* the gather directions (q.gather of them) */
     uint64_t links;     /* Phase One: clusters and elements the transfer took */
+    uint64_t cuts;      /* transfer cuts made (not kept in forest files) */
+    uint64_t cuts_capped; /* of which stopped at their size limit */
     double phase_one_seconds;
     uint64_t rays;
     int loaded;         /* read from a forest file (forest_io.c), not built */

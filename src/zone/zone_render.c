@@ -21,6 +21,8 @@ static void fill_forest_stats(const zone_forest *f, zt_render_stats *stats)
             stats->zones_per_level[f->zones[i].level]++;
     stats->memory_bytes = forest_memory(f);
     stats->forest_loaded = f->loaded;
+    stats->cuts = f->cuts;
+    stats->cuts_capped = f->cuts_capped;
 }
 
 zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err)

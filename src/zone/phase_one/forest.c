@@ -268,8 +268,8 @@ vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n)
     const rscene *rs = &t->r->rs;
     if (t->f->light_tree.elem_count > 0) {
         light_leaf_ctx lc = {t, receiver};
-        cut_params p = {t->f->q.eps, 0, 4096, light_leaf, &lc};
-        cut_stats st = {0, 0};
+        cut_params p = {.eps = t->f->q.eps, .max_cut = 4096, .leaf = light_leaf, .user = &lc};
+        cut_stats st = {0};
         vec3 e = cut_gather(&t->f->light_tree, rs, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)),
                             &p, &st);
         t->rays += st.rays;

@@ -79,7 +79,7 @@ static vec3 node_point(const surface_nodes *sn, int32_t k, vec3 *n)
 
 /* Level `level`'s irradiance at live node k (without the caustics). */
 static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const transfer_ctx *tc,
-                       int32_t k, uint64_t *rays, uint64_t *links)
+                       int32_t k, uint64_t *rays, uint64_t *links, uint64_t *capped)
 {
     const surface_nodes *sn = &f->sn;
     zone_trace t = {f, r, 0};
@@ -96,10 +96,11 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
          * texels had). */
         transfer_ctx tk = *tc;
         tk.eps = tc->eps * sqrt(sn->growth[k]);
-        transfer_stats ts = {0, 0};
+        transfer_stats ts = {0};
         e = transfer_irradiance(&tk, x, n, prim, &ts);
         t.rays += ts.rays;
         *links += ts.clusters;
+        *capped += ts.capped;
         if (level == 1 && f->glint_count)
             e = v3_add(e, glint_irradiance(&t, f->glint_spheres, f->glint_count, x, n,
                                            f->q.glint_cuts));
@@ -159,6 +160,14 @@ static double cut_floor(const sender_tree *tree)
     return area > 0 ? FLOOR_SHARE * 3.14159265358979 * tree->total_power / area : 0;
 }
 
+/* Clusters a receiver's cut opens at most; past them the cut's clusters
+ * stay as estimated (no light is left out).  Lightcuts (Walter et al.
+ * 2005) caps its cuts at 1000.  The engine room at depth 3, 512 x 512:
+ * 1024 takes 3.3 times fewer rays than 4096 for 1.90% per pixel and 1.29%
+ * over 4 x 4 blocks against 1.84% and 1.21%; 512 gave 2.15% and 1.61%.
+ * How many cuts reach it is reported (zt_render_stats). */
+#define MAX_CUT 1024
+
 /* Threads take nodes in chunks this long, and check the clock once a
  * chunk. */
 #define NODE_BLOCK 64
@@ -181,21 +190,22 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
     const rscene *rs = &r->rs;
     const surface_nodes *sn = &f->sn;
     const zt_render_options *o = &r->options;
-    transfer_ctx tc = {tree, sn, rs, level > 0 ? zone_e(f, level - 1, 0) : NULL,
-                       f->q.eps, f->q.theta, 0, 4096};
+    transfer_ctx tc = {.tree = tree, .sn = sn, .rs = rs,
+                       .e = level > 0 ? zone_e(f, level - 1, 0) : NULL, .eps = f->q.eps,
+                       .theta = f->q.theta, .max_cut = MAX_CUT};
     if (level > 0)
         tc.floor = cut_floor(tree);
     float *v = calloc(3 * (size_t)sn->node_count + 3, sizeof(float));
     if (!v)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for level %d's node values", level);
-    uint64_t rays = 0, links = 0;
+    uint64_t rays = 0, links = 0, capped = 0, cuts = 0;
     int threads = render_thread_count(o->threads);
     const volatile sig_atomic_t *stop = o->stop;
     int quit = 0;
     zt_status st = ZT_OK;
     int passes = mr->round && MESH_ROUNDS > NODE_ROUNDS ? MESH_ROUNDS : NODE_ROUNDS;
     for (int pass = 0; pass < passes && !quit && st == ZT_OK; pass++) {
-#pragma omp parallel for schedule(dynamic, NODE_BLOCK) num_threads(threads) reduction(+ : rays, links)
+#pragma omp parallel for schedule(dynamic, NODE_BLOCK) num_threads(threads) reduction(+ : rays, links, capped, cuts)
         for (int k = 0; k < sn->node_count; k++) {
             int q;
 #pragma omp atomic read
@@ -226,7 +236,8 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
             } else if (vertex && mesh_rounds_read(mr, sn, v, k, SMOOTH, read)) {
                 e = v3(read[0], read[1], read[2]);
             } else {
-                e = node_value(f, r, level, &tc, k, &rays, &links);
+                e = node_value(f, r, level, &tc, k, &rays, &links, &capped);
+                cuts += level > 0;
             }
             v[3 * (size_t)k] = (float)e.x;
             v[3 * (size_t)k + 1] = (float)e.y;
@@ -252,6 +263,8 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
         }
     free(v);
     f->links += links;
+    f->cuts += cuts;
+    f->cuts_capped += capped;
     return st;
 }
 
@@ -330,12 +343,15 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
     }
     if (share_ranks(&r->options) > 1) {
         /* The counts are the whole job's, as one process's would be. */
-        double n[2] = {(double)f->rays, (double)f->links};
-        st = share_sum(&r->options, n, 2, err);
+        double n[4] = {(double)f->rays, (double)f->links, (double)f->cuts,
+                       (double)f->cuts_capped};
+        st = share_sum(&r->options, n, 4, err);
         if (st != ZT_OK)
             return st;
         f->rays = (uint64_t)n[0];
         f->links = (uint64_t)n[1];
+        f->cuts = (uint64_t)n[2];
+        f->cuts_capped = (uint64_t)n[3];
     }
     return zone_forest_zones(f, r, err);
 }

@@ -16,6 +16,7 @@
 typedef struct cut_stats {
     uint64_t rays;
     uint64_t clusters;  /* clusters and elements evaluated */
+    uint64_t capped;    /* cuts stopped by max_cut, not by eps */
 } cut_stats;
 
 /* Adds element i's exact contribution at (x, n) to acc. */

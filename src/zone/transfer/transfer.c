@@ -214,6 +214,7 @@ vec3 transfer_irradiance(const transfer_ctx *c, vec3 x, vec3 n, int receiver,
                          transfer_stats *st)
 {
     (void)receiver;
-    cut_params p = {c->eps, c->floor, c->max_cut, leaf, (void *)c};
+    cut_params p = {.eps = c->eps, .floor = c->floor, .max_cut = c->max_cut,
+                    .leaf = leaf, .user = (void *)c};
     return cut_gather(c->tree, c->rs, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)), &p, st);
 }
