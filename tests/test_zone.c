@@ -310,6 +310,8 @@ static void test_forest_round_trip(void **state)
     zt_image *built = accumulate(r, s, &built_stats);
     assert_int_equal(built_stats.forest_loaded, 0);
     assert_true(built_stats.zones > 0 && built_stats.memory_bytes > 0);
+    /* Depth 3 builds two transfer levels: a cut per computed node each. */
+    assert_true(built_stats.cuts > 0 && built_stats.cuts_capped <= built_stats.cuts);
 
     for (int strategy = 0; strategy < 2; strategy++) {
         zt_render_options lo = o;
@@ -320,6 +322,7 @@ static void test_forest_round_trip(void **state)
         zt_image *loaded = render(s, &lo, &stats);
         test_assert_same_image(built, loaded, "built vs loaded forest");
         assert_int_equal(stats.forest_loaded, 1);
+        assert_int_equal(stats.cuts, 0); /* not kept in the file */
         assert_int_equal(stats.zones, built_stats.zones);
         assert_int_equal(stats.zones_pruned, built_stats.zones_pruned);
         assert_int_equal(stats.memory_bytes, built_stats.memory_bytes);

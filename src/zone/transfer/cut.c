@@ -11,9 +11,10 @@
 #define HEAP_MAX 8192
 /* A cluster is seen through rays to its descendants this many levels
  * below its children (two rays at 0, four at 1).  The engine room at depth
- * 3, 512 x 512: the same error with two (1.84% per pixel, 1.21% over 4 x 4
- * blocks) for a quarter fewer rays; the Cornell box: 0.566% with two
- * against 0.549% with four.  Eight rays gained nothing more. */
+ * 3, 512 x 512, with cuts of up to 4096 clusters: a quarter fewer rays with
+ * two, the error within 0.01 points (1.84% per pixel, 1.21% over 4 x 4
+ * blocks); the Cornell box: 0.566% with two against 0.549% with four.
+ * Eight rays gained nothing more. */
 #define SEEN_DEPTH 0
 
 typedef struct cand {
