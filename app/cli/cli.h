@@ -58,7 +58,10 @@ int cli_animate(const char *scene_path, const zt_render_options *options,
 typedef struct cli_progress {
     int verbose;
     int tty;
-    double start;
+    double start;       /* when the stage being reported was first heard */
+    double start_frac;  /* and how far along it was then */
+    char stage[32];     /* its name: a new one restarts the clock, so the
+                           zone stage's ETA leaves Phase One out */
     double last_print;
     int last_decile;
 } cli_progress;

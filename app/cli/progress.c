@@ -1,6 +1,7 @@
 /* Progress display for -v. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
+#include <string.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -18,6 +19,8 @@ void cli_progress_init(cli_progress *p, int verbose)
     p->verbose = verbose;
     p->tty = isatty(2);
     p->start = cli_now();
+    p->start_frac = 0;
+    p->stage[0] = '\0';
     p->last_print = 0;
     p->last_decile = -1;
 }
@@ -37,11 +40,18 @@ int cli_progress_callback(void *user, const char *stage, double done, double tot
     cli_progress *p = user;
     if (!p->verbose || total <= 0)
         return 0;
-    double now = cli_now(), elapsed = now - p->start;
-    double frac = done / total;
+    double now = cli_now();
+    if (strncmp(p->stage, stage, sizeof p->stage - 1) != 0) {
+        snprintf(p->stage, sizeof p->stage, "%s", stage);
+        p->start = now;
+        p->start_frac = done / total;
+        p->last_decile = -1;
+    }
+    double elapsed = now - p->start;
+    double frac = done / total, run = frac - p->start_frac;
     char eta[32] = "?";
-    if (frac > 0.001)
-        format_duration(eta, sizeof eta, elapsed * (1.0 - frac) / frac);
+    if (run > 0.001)
+        format_duration(eta, sizeof eta, elapsed * (1.0 - frac) / run);
     if (p->tty) {
         if (now - p->last_print < 0.1 && frac < 1.0)
             return 0;
