@@ -312,6 +312,9 @@ static void test_forest_round_trip(void **state)
     assert_true(built_stats.zones > 0 && built_stats.memory_bytes > 0);
     /* Depth 3 builds two transfer levels: a cut per computed node each. */
     assert_true(built_stats.cuts > 0 && built_stats.cuts_capped <= built_stats.cuts);
+    /* Reported with the first image too (the renderer was made without
+     * stats, as when the command line saves the forest first). */
+    assert_true(built_stats.memory_estimate > 0);
 
     for (int strategy = 0; strategy < 2; strategy++) {
         zt_render_options lo = o;

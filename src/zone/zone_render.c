@@ -11,7 +11,7 @@
 #include "zone/phase_two/phase_two.h"
 #include "zone/zone.h"
 
-static void fill_forest_stats(const zone_forest *f, zt_render_stats *stats)
+static void fill_forest_stats(const zone_forest *f, const zt_renderer *r, zt_render_stats *stats)
 {
     stats->zones = (uint64_t)f->zone_count;
     stats->zones_pruned = f->pruned;
@@ -23,6 +23,9 @@ static void fill_forest_stats(const zone_forest *f, zt_render_stats *stats)
     stats->forest_loaded = f->loaded;
     stats->cuts = f->cuts;
     stats->cuts_capped = f->cuts_capped;
+    /* Here, not only at creation: a renderer made without stats (saving
+     * its forest first) reports it with its first image. */
+    stats->memory_estimate = r->memory_estimate + memory_zone_nodes(f->sn.node_count, f->map_levels);
 }
 
 zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err)
@@ -45,9 +48,7 @@ zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err)
         f->build_seconds = f->phase_one_seconds;
     if (stats) {
         stats->phase_one_seconds = f->phase_one_seconds;
-        fill_forest_stats(f, stats);
-        stats->memory_estimate = r->memory_estimate +
-                                 memory_zone_nodes(f->sn.node_count, f->map_levels);
+        fill_forest_stats(f, r, stats);
     }
     return st;
 }
@@ -129,7 +130,7 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
         /* Phase One is charged to the first image of the renderer only. */
         stats->phase_one_seconds = f->images == 0 ? f->phase_one_seconds : 0.0;
         stats->phase_two_seconds = render_clock() - t0;
-        fill_forest_stats(f, stats);
+        fill_forest_stats(f, r, stats);
     }
     if (st == ZT_OK && !reference)
         f->images++;
