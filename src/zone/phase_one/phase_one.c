@@ -162,10 +162,11 @@ static double cut_floor(const sender_tree *tree)
 
 /* Clusters a receiver's cut opens at most; past them the cut's clusters
  * stay as estimated (no light is left out).  Lightcuts (Walter et al.
- * 2005) caps its cuts at 1000.  The engine room at depth 3, 512 x 512:
- * 1024 takes 3.3 times fewer rays than 4096 for 1.90% per pixel and 1.29%
- * over 4 x 4 blocks against 1.84% and 1.21%; 512 gave 2.15% and 1.61%.
- * How many cuts reach it is reported (zt_render_stats). */
+ * 2005) caps its cuts at 1000.  The engine room at depth 3, 512 x 512
+ * (rays of the whole job, error per pixel / over 4 x 4 blocks): 512 takes
+ * 66 M rays for 2.19% / 1.66%, 1024 149 M for 1.95% / 1.37%, 2048 344 M
+ * and 4096 537 M for 1.89% / 1.30%.  How many cuts reach it is reported
+ * (zt_render_stats). */
 #define MAX_CUT 1024
 
 /* Threads take nodes in chunks this long, and check the clock once a
