@@ -229,6 +229,80 @@ static void test_time_limits(void **state)
     zt_scene_release(s);
 }
 
+/* What a render reported: each Phase One level's stage, how far it came,
+ * and whether Phase Two had begun by then; cancels in stage `cancel_in`
+ * once past `cancel_at` of it. */
+typedef struct reports {
+    char stages[4][32];
+    double reached[4];
+    int count, phase_two_seen, phase_one_after;
+    const char *cancel_in;
+    double cancel_at;
+} reports;
+
+static int record(void *user, const char *stage, double done, double total)
+{
+    reports *r = user;
+    if (strncmp(stage, "phase one", 9) != 0) {
+        r->phase_two_seen = 1;
+        return 0;
+    }
+    r->phase_one_after |= r->phase_two_seen;
+    int i = 0;
+    while (i < r->count && strcmp(r->stages[i], stage) != 0)
+        i++;
+    if (i == r->count && r->count < 4)
+        snprintf(r->stages[r->count++], sizeof r->stages[0], "%s", stage);
+    if (i < 4 && done / total > r->reached[i])
+        r->reached[i] = done / total;
+    return r->cancel_in && strcmp(stage, r->cancel_in) == 0 && done >= r->cancel_at * total;
+}
+
+/* Phase One reports each level it builds as a stage of its own, to the
+ * end, before Phase Two begins; cancelled from the callback halfway
+ * through a level, the render fails with ZT_ERR_CANCELLED and the next
+ * one is whole. */
+static void test_phase_one_progress(void **state)
+{
+    (void)state;
+    zt_scene *s = cornell(16);
+    zt_error err = {0};
+    zt_render_options o = zt_render_options_default();
+    o.method = ZT_METHOD_ZONE;
+    o.depth = 3;
+    o.quality = 1;
+    reports r = {0};
+    o.progress = record;
+    o.progress_user = &r;
+    zt_image *img = NULL, *again = NULL;
+    zt_render_stats st;
+    assert_int_equal(zt_render(s, &o, &img, &st, &err), ZT_OK);
+    assert_int_equal(r.count, 3);
+    const char *want[3] = {"phase one 1/3", "phase one 2/3", "phase one 3/3"};
+    for (int i = 0; i < 3; i++) {
+        assert_string_equal(r.stages[i], want[i]);
+        assert_true(r.reached[i] == 1.0);
+    }
+    assert_true(r.phase_two_seen);
+    assert_false(r.phase_one_after);
+
+    reports c = {.cancel_in = "phase one 2/3", .cancel_at = 0.3};
+    o.progress_user = &c;
+    zt_image *none = NULL;
+    assert_int_equal(zt_render(s, &o, &none, &st, &err), ZT_ERR_CANCELLED);
+    assert_null(none);
+    assert_non_null(strstr(err.message, "Phase One"));
+    assert_int_equal(c.count, 2);
+    assert_false(c.phase_two_seen);
+
+    o.progress = NULL;
+    assert_int_equal(zt_render(s, &o, &again, &st, &err), ZT_OK);
+    test_assert_same_image(img, again, "after a cancelled render");
+    zt_image_release(again);
+    zt_image_release(img);
+    zt_scene_release(s);
+}
+
 /* Refused before any work, with the size needed. */
 static void test_memory_limits(void **state)
 {
@@ -448,6 +522,7 @@ int main(void)
         cmocka_unit_test(test_stop_and_resume_same_bits),
         cmocka_unit_test(test_bad_checkpoints),
         cmocka_unit_test(test_time_limits),
+        cmocka_unit_test(test_phase_one_progress),
         cmocka_unit_test(test_memory_limits),
         cmocka_unit_test(test_cli_interrupts),
         cmocka_unit_test(test_cli_options),

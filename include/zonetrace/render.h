@@ -29,8 +29,10 @@ typedef enum zt_strategy {
 } zt_strategy;
 
 /* Called from the rendering threads, serialised, about a hundred times per
- * render.  done/total count work units (rows of tiles, zones...).  Return
- * non-zero to cancel the render (it then fails with ZT_ERR_CANCELLED). */
+ * stage of a render (the zone tracer's are "phase one K/N" for each level
+ * of light it builds, then Phase Two's).  done/total count work units
+ * (rows of tiles, nodes, zones...).  Return non-zero to cancel the render
+ * (it then fails with ZT_ERR_CANCELLED). */
 typedef int (*zt_progress_fn)(void *user, const char *stage, double done,
                               double total);
 

@@ -12,6 +12,7 @@
  * needs E_0 .. E_{D-1}. */
 #include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -203,6 +204,14 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
     int threads = render_thread_count(o->threads);
     const volatile sig_atomic_t *stop = o->stop;
     int quit = 0;
+    /* Progress in nodes settled (computed or read: each in one pass). */
+    double owned = 0;
+    for (int k = 0; k < sn->node_count; k++)
+        owned += sn->live[k] && share_owns(o, k / SHARE_BLOCK);
+    char stage[48];
+    snprintf(stage, sizeof stage, "phase one %d/%d", level + 1, f->map_levels);
+    progress prog;
+    progress_init(&prog, o, stage, owned > 0 ? owned : 1);
     zt_status st = ZT_OK;
     int passes = mr->round && MESH_ROUNDS > NODE_ROUNDS ? MESH_ROUNDS : NODE_ROUNDS;
     for (int pass = 0; pass < passes && !quit && st == ZT_OK; pass++) {
@@ -213,7 +222,8 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
             q = quit;
             if (q)
                 continue;
-            if (k % NODE_BLOCK == 0 && (render_clock() > until || (stop && *stop))) {
+            if (k % NODE_BLOCK == 0 &&
+                (render_clock() > until || (stop && *stop) || prog.cancelled)) {
 #pragma omp atomic write
                 quit = 1;
                 continue;
@@ -243,6 +253,7 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
             v[3 * (size_t)k] = (float)e.x;
             v[3 * (size_t)k + 1] = (float)e.y;
             v[3 * (size_t)k + 2] = (float)e.z;
+            progress_add(&prog, 1.0);
         }
         if (share_ranks(o) > 1) {
             /* Earlier rounds' values are equal everywhere, this round's
@@ -255,6 +266,8 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
         }
     }
     f->rays += rays;
+    if (prog.cancelled && st == ZT_OK)
+        st = zt_fail(err, ZT_ERR_CANCELLED, "render cancelled in Phase One");
     *abandoned = quit;
     if (!quit && st == ZT_OK)
         for (int k = 0; k < sn->node_count; k++) {
