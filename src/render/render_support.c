@@ -66,6 +66,8 @@ void progress_init(progress *p, const zt_render_options *o, const char *stage,
 
 void progress_add(progress *p, double amount)
 {
+    if (!p->fn)
+        return; /* nobody to tell: no lock taken */
 #pragma omp critical(zt_progress)
     {
         p->done += amount;
