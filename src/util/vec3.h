@@ -23,6 +23,13 @@ static inline vec3 v3_normalize(vec3 a)
     double l = v3_length(a);
     return l > 0 ? v3_scale(a, 1.0 / l) : a;
 }
+/* Unit tangents t, b completing unit n to a right-handed frame (t, b, n). */
+static inline void v3_frame(vec3 n, vec3 *t, vec3 *b)
+{
+    vec3 a = fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0);
+    *t = v3_normalize(v3_cross(a, n));
+    *b = v3_cross(n, *t);
+}
 /* min and max without fmin/fmax's NaN rules, which keep the compiler from
  * inlining them (hot loops over boxes). */
 static inline double dmin(double a, double b) { return a < b ? a : b; }

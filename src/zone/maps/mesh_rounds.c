@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "scene/mesh.h"
+#include "util/vec3.h"
 
 #define PI 3.14159265358979323846
 
@@ -58,18 +59,13 @@ static int by_angle(const void *a, const void *b)
     return (x->angle > y->angle) - (x->angle < y->angle);
 }
 
+/* The tangent frame the sectors and the fit are taken in. */
 static void tangents(const float *n, double t[3], double b[3])
 {
-    double a[3] = {fabs(n[0]) > 0.5 ? 0 : 1, fabs(n[0]) > 0.5 ? 1 : 0, 0};
-    t[0] = a[1] * n[2] - a[2] * n[1];
-    t[1] = a[2] * n[0] - a[0] * n[2];
-    t[2] = a[0] * n[1] - a[1] * n[0];
-    double l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    for (int i = 0; i < 3; i++)
-        t[i] /= l;
-    b[0] = n[1] * t[2] - n[2] * t[1];
-    b[1] = n[2] * t[0] - n[0] * t[2];
-    b[2] = n[0] * t[1] - n[1] * t[0];
+    vec3 tt, bb;
+    v3_frame(v3(n[0], n[1], n[2]), &tt, &bb);
+    t[0] = tt.x, t[1] = tt.y, t[2] = tt.z;
+    b[0] = bb.x, b[1] = bb.y, b[2] = bb.z;
 }
 
 /* A mesh's vertices' neighbours along its edges. */

@@ -29,19 +29,12 @@
 #include "zone/transfer/transfer.h"
 #include "zone/zone.h"
 
-static void frame(vec3 n, vec3 *t, vec3 *b)
-{
-    vec3 a = fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0);
-    *t = v3_normalize(v3_cross(a, n));
-    *b = v3_cross(n, *t);
-}
-
 vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 {
     const zone_forest *f = t->f;
     const rscene *rs = &t->r->rs;
     vec3 tt, bb;
-    frame(n, &tt, &bb);
+    v3_frame(n, &tt, &bb);
     vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
     int open = 0;
     for (int k = 0; k < f->q.gather; k++) {
@@ -60,7 +53,7 @@ static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
 {
     const zone_forest *f = t->f;
     vec3 tt, bb;
-    frame(n, &tt, &bb);
+    v3_frame(n, &tt, &bb);
     vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
     vec3 sum = v3(0, 0, 0);
     for (int k = 0; k < f->q.gather; k++) {
