@@ -30,6 +30,29 @@ static void box_add(vec3 *lo, vec3 *hi, vec3 q)
     *hi = v3_max3(*hi, q);
 }
 
+/* Whether q, where planes a, b and c meet, is a corner of the room the
+ * objects (centred at `centre`) stand in: they are in front of all three,
+ * and q is on or in front of every plane of the scene. */
+static int inside_corner(const zt_scene *sc, int a, int b, int c, vec3 centre, vec3 q,
+                         int finite)
+{
+    if (!finite)
+        return 0;
+    const int abc[3] = {a, b, c};
+    for (int i = 0; i < 3; i++) {
+        const part *p = &sc->parts[abc[i]];
+        if (!(v3_dot(p->normal, centre) > p->offset))
+            return 0;
+    }
+    for (int i = 0; i < sc->part_count; i++) {
+        const part *p = &sc->parts[i];
+        if (p->shape == SHAPE_PLANE && i != a && i != b && i != c &&
+            v3_dot(p->normal, q) < p->offset - 1e-6 * (1 + fabs(p->offset)))
+            return 0;
+    }
+    return 1;
+}
+
 void zone_scene_bounds(const zt_scene *sc, const rscene *rs, vec3 *lo, vec3 *hi)
 {
     *lo = v3(1e300, 1e300, 1e300);
@@ -58,7 +81,9 @@ void zone_scene_bounds(const zt_scene *sc, const rscene *rs, vec3 *lo, vec3 *hi)
     vec3 centre = finite ? v3_scale(v3_add(*lo, *hi), 0.5) : v3(0, 0, 0);
     double reach = finite ? 2.0 * v3_length(v3_sub(*hi, *lo)) + 1e-9 : 1e6;
     /* Rooms made of planes reach past the objects in them: add the corners
-     * where three planes meet, unless they lie far away. */
+     * where three planes meet, unless they lie far away and the objects
+     * are not in front of all three (a corner of the room they stand in,
+     * however small they are: else its walls fall inside growing cells). */
     vec3 add_lo = *lo, add_hi = *hi;
     for (int a = 0; a < sc->part_count; a++) {
         const part *pa = &sc->parts[a];
@@ -77,7 +102,8 @@ void zone_scene_bounds(const zt_scene *sc, const rscene *rs, vec3 *lo, vec3 *hi)
                                                 v3_scale(v3_cross(pc->normal, pa->normal), pb->offset)),
                                          v3_scale(v3_cross(pa->normal, pb->normal), pc->offset)),
                                   1.0 / det);
-                if (v3_length(v3_sub(q, centre)) <= reach)
+                if (inside_corner(sc, a, b, k, centre, q, finite) ||
+                    v3_length(v3_sub(q, centre)) <= reach)
                     box_add(&add_lo, &add_hi, q);
             }
         }
