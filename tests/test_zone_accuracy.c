@@ -1,7 +1,8 @@
 /* The zone tracer against converged path-traced references, level by level:
  * the project's Cornell box at 48x48, references in
  * tests/data/zone_references (made by make_zone_references.sh, which prints
- * their own noise).
+ * their own noise); and a room of planes against the path tracer rendered
+ * in the test.
  *
  * The bounds are regression bounds at the default quality: the errors
  * measured when they were set, with a margin of about a quarter.  They are
@@ -148,24 +149,20 @@ static void test_error_shrinks_with_quality(void **state)
  * -0.6% (without the corners 6.1%, -5.1%). */
 #define ROOM_PLANE(NX, NY, NZ, OFFSET, R, G, B)                                              \
     "{\"plane\": {\"normal\": [" #NX ", " #NY ", " #NZ "], \"offset\": " #OFFSET            \
-    ", \"backculled\": true, \"material\": " DIFFUSE(R, G, B) "}},"
-#define DIFFUSE(r, g, b)                                                                     \
-    "{\"character\": {\"diffuse\": 1, \"metallic\": 0, \"reflecting\": 0, "                \
-    "\"refractive\": 0}, \"color\": [" #r ", " #g ", " #b "]}"
+    ", \"backculled\": true, " TEST_DIFFUSE_HEAD #R ", " #G ", " #B "]}}}"
 static const char *room_text =
     "{\"camera\": {\"position\": [360, 230, 30], \"lookat\": [200, 70, 210], "
     "\"up\": [0, 1, 0], \"fov\": 42, \"gridresolution\": [32, 32]}, \"scene\": ["
     "{\"light\": {\"emission\": [40, 36, 30], \"backculled\": true, \"parts\": ["
     "{\"lighttriangle\": {\"points\": [[150, 299, 150], [250, 299, 150], [250, 299, 250]]}},"
     "{\"lighttriangle\": {\"points\": [[150, 299, 150], [250, 299, 250], [150, 299, 250]]}}"
-    "]}},"
-    ROOM_PLANE(0, 1, 0, 0, 0.7, 0.68, 0.64)
-    ROOM_PLANE(0, -1, 0, -300, 0.8, 0.8, 0.8)
-    ROOM_PLANE(1, 0, 0, 0, 0.25, 0.45, 0.7)
-    ROOM_PLANE(-1, 0, 0, -400, 0.8, 0.8, 0.8)
-    ROOM_PLANE(0, 0, 1, 0, 0.8, 0.8, 0.8)
-    "{\"plane\": {\"normal\": [0, 0, -1], \"offset\": -400, \"backculled\": true, "
-    "\"material\": " DIFFUSE(0.75, 0.55, 0.4) "}}"
+    "]}}, "
+    ROOM_PLANE(0, 1, 0, 0, 0.7, 0.68, 0.64) ", "
+    ROOM_PLANE(0, -1, 0, -300, 0.8, 0.8, 0.8) ", "
+    ROOM_PLANE(1, 0, 0, 0, 0.25, 0.45, 0.7) ", "
+    ROOM_PLANE(-1, 0, 0, -400, 0.8, 0.8, 0.8) ", "
+    ROOM_PLANE(0, 0, 1, 0, 0.8, 0.8, 0.8) ", "
+    ROOM_PLANE(0, 0, -1, -400, 0.75, 0.55, 0.4)
     "]}";
 
 static void test_room_of_planes(void **state)
