@@ -21,6 +21,17 @@
  * cell inside (the old texel centres were half a cell inside). */
 #define EDGE_INSET 0.25
 
+/* A model's triangles take nodes at half the spacing.  Their corners are
+ * the model's vertices, on its creases and seams, where the parts around
+ * shade them; a triangle up to h long would otherwise be read, and send
+ * its light, from those corners alone.  On the engine room at depth 3 this
+ * takes the error over 4 x 4 blocks from 1.36% to 1.06% for 20% more
+ * Phase One.  Triangles written in the scene file keep h: their edge nodes
+ * sit a quarter cell inside, and half the spacing made the shipped scenes
+ * no better (triangletest 0.65% -> 0.83%) for up to 3.7 times the Phase
+ * One. */
+#define MODEL_SPACING 0.5
+
 static int tri_total(int n) { return (n + 1) * (n + 2) / 2; }
 /* Row j of a triangle's grid starts here (row j holds n - j + 1 nodes). */
 static int tri_row(int n, int j) { return j * (n + 1) - j * (j - 1) / 2; }
@@ -218,7 +229,8 @@ int surface_nodes_build(surface_nodes *sn, const rscene *rs, const zt_scene *sce
         case SHAPE_TRIANGLE: {
             vec3f a = p->e1, b = p->e2, c = f3_sub(p->e2, p->e1);
             double edge = fmax(f3_length(a), fmax(f3_length(b), f3_length(c)));
-            int n = (int)ceil(edge / h - 1e-9);
+            double spacing = prim >= rs->part_count ? MODEL_SPACING * h : h;
+            int n = (int)ceil(edge / spacing - 1e-9);
             np->kind = NODE_TRIANGLE;
             np->n = (uint16_t)(n < 1 ? 1 : n > MAX_TRI_STEPS ? MAX_TRI_STEPS : n);
             np->shared = prim >= rs->part_count &&

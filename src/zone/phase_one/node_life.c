@@ -127,10 +127,12 @@ static int slab(const occ_node *b, vec3 o, vec3 inv, double tmax)
     return 1;
 }
 
-int node_life_first_hit(const occluder_index *occ, const zt_scene *scene, const rscene *rs,
-                        vec3 o, vec3 d, int *back)
+/* The nearest hit of ray (o, d) closer than tmax (node_life_first_hit);
+ * *dist its distance. */
+static int first_hit(const occluder_index *occ, const zt_scene *scene, const rscene *rs, vec3 o,
+                     vec3 d, double tmax, int *back, double *dist)
 {
-    double best = INFINITY;
+    double best = tmax;
     int found = -1;
     for (int i = 0; i < rs->part_count; i++) {
         if (scene->parts[i].shape != SHAPE_PLANE)
@@ -145,6 +147,7 @@ int node_life_first_hit(const occluder_index *occ, const zt_scene *scene, const 
             *back = b;
         }
     }
+    *dist = best;
     if (occ->prim_count == 0)
         return found;
     vec3 inv = v3(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
@@ -175,7 +178,15 @@ int node_life_first_hit(const occluder_index *occ, const zt_scene *scene, const 
             stack[sp++] = node->left;
         }
     }
+    *dist = best;
     return found;
+}
+
+int node_life_first_hit(const occluder_index *occ, const zt_scene *scene, const rscene *rs,
+                        vec3 o, vec3 d, int *back)
+{
+    double t;
+    return first_hit(occ, scene, rs, o, d, INFINITY, back, &t);
 }
 
 /* A fixed set of directions around the normal (a golden-angle spiral over
@@ -187,6 +198,88 @@ static vec3 probe_dir(vec3 n, int k)
     double u = (k + 0.5) / PROBES, r = sqrt(u), phi = k * 2.39996322972865332;
     return v3_normalize(v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))),
                                v3_scale(n, sqrt(1.0 - u))));
+}
+
+static vec3 node_pos(const surface_nodes *sn, int32_t k)
+{
+    return v3(sn->pos[3 * k], sn->pos[3 * k + 1], sn->pos[3 * k + 2]);
+}
+
+/* A model's vertex sunk into another closed part (a fin's root in the
+ * cylinder it stands on) is dead, yet the triangles around it show outside
+ * that part, and read from their live corners alone they would carry the
+ * light of those corners right down to the junction (on the engine room
+ * its fins were 8% too bright at the first bounce).  Such a vertex is
+ * raised: along an element's edge from a live corner to just before the
+ * first surface on the way, where the edge leaves the open space, and
+ * lives there, so its light is the junction's.  Of several live corners,
+ * the one whose junction lies nearest the vertex wins.  A vertex dead with
+ * no surface in between stays dead.  Only the vertices: raising a large
+ * triangle's own grid nodes as well made the engine room's first bounce
+ * worse (2.82% -> 2.88% over 4 x 4 blocks), by nodes raised onto the very
+ * part that hides them.  Returns the rays traced. */
+static uint64_t raise_sunk_vertices(surface_nodes *sn, const occluder_index *occ,
+                                 const zt_scene *scene, const rscene *rs)
+{
+    double *gap = malloc((size_t)sn->node_count * sizeof *gap);
+    vec3 *to = malloc((size_t)sn->node_count * sizeof *to);
+    uint64_t rays = 0;
+    if (!gap || !to) {
+        /* Without memory the nodes stay dead, as they were. */
+        free(gap);
+        free(to);
+        return 0;
+    }
+    for (int k = 0; k < sn->node_count; k++)
+        gap[k] = INFINITY;
+    double lift = 1e-4 * sn->h;
+    for (int prim = 0; prim < sn->prim_count; prim++) {
+        const node_prim *np = &sn->prim[prim];
+        if (np->kind != NODE_TRIANGLE || !np->shared || np->first < 0)
+            continue;
+        int elements = surface_element_count(sn, prim);
+        for (int side = 0; side < np->sides; side++)
+            for (int e = 0; e < elements; e++) {
+                vec3 q[4];
+                int32_t c[4];
+                surface_element(sn, rs, prim, side, e, q, c);
+                int alive = sn->live[c[0]] + sn->live[c[1]] + sn->live[c[2]];
+                if (alive == 0 || alive == 3)
+                    continue;
+                for (int a = 0; a < 3; a++)
+                    for (int b = 0; b < 3; b++) {
+                        int32_t k = c[a], j = c[b];
+                        /* (A grid node of its own is not a vertex.) */
+                        if (sn->live[k] || !sn->live[j] ||
+                            (k >= np->first && k < np->first + np->sides * np->count))
+                            continue;
+                        vec3 nj = v3(sn->nrm[3 * j], sn->nrm[3 * j + 1], sn->nrm[3 * j + 2]);
+                        vec3 o = v3_add(node_pos(sn, j), v3_scale(nj, lift));
+                        vec3 w = v3_sub(node_pos(sn, k), o);
+                        double len = v3_length(w), t;
+                        if (!(len > 0))
+                            continue;
+                        vec3 d = v3_scale(w, 1.0 / len);
+                        int back;
+                        rays++;
+                        if (first_hit(occ, scene, rs, o, d, len, &back, &t) < 0 ||
+                            !(len - t < gap[k]))
+                            continue;
+                        gap[k] = len - t;
+                        to[k] = v3_add(o, v3_scale(d, 0.99 * t));
+                    }
+            }
+    }
+    for (int k = 0; k < sn->node_count; k++)
+        if (gap[k] < INFINITY) {
+            sn->pos[3 * k] = (float)to[k].x;
+            sn->pos[3 * k + 1] = (float)to[k].y;
+            sn->pos[3 * k + 2] = (float)to[k].z;
+            sn->live[k] = 1;
+        }
+    free(gap);
+    free(to);
+    return rays;
 }
 
 uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_scene *scene,
@@ -243,5 +336,5 @@ uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_s
         sn->pos[3 * k + 2] = (float)x.z;
     }
     free(walls);
-    return rays;
+    return rays + raise_sunk_vertices(sn, occ, scene, rs);
 }
