@@ -25,8 +25,8 @@
  * the model's vertices, on its creases and seams, where the parts around
  * shade them; a triangle up to h long would otherwise be read, and send
  * its light, from those corners alone.  On the engine room at depth 3 this
- * takes the error over 4 x 4 blocks from 1.36% to 1.06% for 20% more
- * Phase One.  Triangles written in the scene file keep h: their edge nodes
+ * takes the error over 4 x 4 blocks from 1.36% to 1.06% for about 15% more
+ * time.  Triangles written in the scene file keep h: their edge nodes
  * sit a quarter cell inside, and half the spacing made the shipped scenes
  * no better (triangletest 0.65% -> 0.83%) for up to 3.7 times the Phase
  * One. */
