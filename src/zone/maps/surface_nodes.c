@@ -22,14 +22,16 @@
 #define EDGE_INSET 0.25
 
 /* A model's triangles take nodes at half the spacing.  Their corners are
- * the model's vertices, on its creases and seams, where the parts around
- * shade them; a triangle up to h long would otherwise be read, and send
- * its light, from those corners alone.  On the engine room at depth 3 this
- * takes the error over 4 x 4 blocks from 1.36% to 1.06% for about 15% more
- * time.  Triangles written in the scene file keep h: their edge nodes
- * sit a quarter cell inside, and half the spacing made the shipped scenes
- * no better (triangletest 0.65% -> 0.83%) for up to 3.7 times the Phase
- * One. */
+ * the model's vertices, often on its creases and seams, where the parts
+ * around shade them; a triangle up to h long would otherwise be read, and
+ * send its light, from its corners alone.  On the engine room at depth 3
+ * this takes the error over 4 x 4 blocks from 1.36% to 1.06% for about 15%
+ * more time (only the triangles with a corner on a crease: 1.14%).  A
+ * smooth sphere of a few hundred triangles gains nothing and its Phase One
+ * takes up to 2.3 times as long (BENCHMARKS.md).  Triangles written in the
+ * scene file keep h: their edge nodes sit a quarter cell inside, and half
+ * the spacing made the shipped scenes no better (triangletest 0.65% ->
+ * 0.83%) for up to 3.7 times the Phase One. */
 #define MODEL_SPACING 0.5
 
 static int tri_total(int n) { return (n + 1) * (n + 2) / 2; }
