@@ -219,7 +219,7 @@ static vec3 node_pos(const surface_nodes *sn, int32_t k)
  * worse (2.82% -> 2.88% over 4 x 4 blocks), by nodes raised onto the very
  * part that hides them.  Returns the rays traced. */
 static uint64_t raise_sunk_vertices(surface_nodes *sn, const occluder_index *occ,
-                                 const zt_scene *scene, const rscene *rs)
+                                    const zt_scene *scene, const rscene *rs)
 {
     double *gap = malloc((size_t)sn->node_count * sizeof *gap);
     vec3 *to = malloc((size_t)sn->node_count * sizeof *to);

@@ -4,11 +4,11 @@
  * meet the back of a back-culled surface).  Dead nodes send nothing and are left out
  * of every read, so light does not leak from under a box standing on the
  * floor, or from outside the room.  A node on a wall's plane (where the
- * wall meets the floor) is moved a hair inside.  A triangle's node sunk
+ * wall meets the floor) is moved a hair inside.  A model's vertex sunk
  * into another part (a fin's root in the cylinder it stands on) is moved
- * along its element's edge to where that edge leaves the open space, and
- * lives there: the element shows outside the part, and its light near the
- * junction is the junction's, not that of its far corners. */
+ * along an edge of its triangle to where that edge leaves the open space,
+ * and lives there: the triangle shows outside the part, and its light near
+ * the junction is the junction's, not that of its far corners. */
 #ifndef ZT_ZONE_PHASE_ONE_NODE_LIFE_H
 #define ZT_ZONE_PHASE_ONE_NODE_LIFE_H
 
