@@ -143,6 +143,24 @@ typedef struct builder {
 static int build_nodes(sender_tree *t);
 static void fill_node(sender_tree *t, int32_t ni);
 
+/* Element i's share of its cluster's power: the luminance of its
+ * radiance times its area. */
+static double elem_power(const sender_tree *t, int32_t i)
+{
+    const float *b = &t->elem_radiance[3 * (size_t)i];
+    return (0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2]) * t->elems[i].area;
+}
+
+/* A fixed number in [0, 1) for node ni (splitmix64). */
+static double rep_number(int32_t ni)
+{
+    uint64_t z = (uint64_t)ni * 0x9e3779b97f4a7c15ull + 0x632be59bd9b4e019ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
+}
+
 /* Sort keys: the centroid's axes 0-2, the normal's 3-5. */
 static float elem_c(const sender_elem *e, int a) { return a < 3 ? e->c[a] : e->n[a - 3]; }
 
@@ -462,23 +480,34 @@ static void fill_node(sender_tree *t, int32_t ni)
     l->power = (float)p;
     for (int a = 0; a < 3; a++)
         l->c[a] = p > 0 ? (float)(c[a] / p) : 0.5f * (node->lo[a] + node->hi[a]);
+    /* The representative is drawn in proportion to power, by a fixed
+     * number per node: the brightest element of a cluster is also its
+     * most exposed one, so always taking it overstates the cluster's
+     * visibility where its elements shade each other. */
+    double u = rep_number(ni);
     if (node->count > 0) {
-        int first = -1 - node->left, best = first;
-        double top = -1;
-        for (int i = first; i < first + node->count; i++) {
-            const float *b = &t->elem_radiance[3 * (size_t)i];
-            double w = (0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2]) * t->elems[i].area;
-            if (w > top) {
-                top = w;
-                best = i;
+        int first = -1 - node->left, best = -1, last = first;
+        double total = 0;
+        for (int i = first; i < first + node->count; i++)
+            total += elem_power(t, i);
+        double acc = 0, aim = u * total;
+        for (int i = first; i < first + node->count && best < 0; i++) {
+            double w = elem_power(t, i);
+            acc += w;
+            if (w > 0) {
+                last = i;
+                if (acc > aim)
+                    best = i;
             }
         }
+        if (best < 0)
+            best = last; /* rounding, or no element with light */
         for (int a = 0; a < 3; a++)
             l->rep[a] = t->elems[best].c[a];
         l->rep_elem = best;
     } else {
         const sender_light *L = &t->light[node->left], *R = &t->light[node->left + 1];
-        const sender_light *pick = R->power > L->power ? R : L;
+        const sender_light *pick = u * ((double)L->power + R->power) < L->power ? L : R;
         for (int a = 0; a < 3; a++)
             l->rep[a] = pick->rep[a];
         l->rep_elem = pick->rep_elem;

@@ -63,8 +63,9 @@ typedef struct sender_light {
     float aflux[6][3];  /* [signed axis][channel] */
     float power;        /* luminance of flux */
     float c[3];
-    /* Where the cluster is seen from: the centroid of its brightest
-     * element's branch (the child with more power, down to an element).
+    /* Where the cluster is seen from: the centroid of one of its
+     * elements, drawn in proportion to power by a fixed number per node
+     * (a child by its share of the power, down to an element).
      * Visibility is tested there, not at the centroid, which may lie
      * inside an object the cluster's elements surround. */
     float rep[3];
