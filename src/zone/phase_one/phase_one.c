@@ -170,11 +170,8 @@ static double cut_floor(const sender_tree *tree)
  * 3, 512 x 512: 512 for E_2 instead of 1024 takes 27% off Phase One (149 M
  * to 106 M rays) for 1.95% -> 1.96% per pixel and 1.37% -> 1.38% over 4 x 4
  * blocks; the shipped scenes at 128 x 128 lose up to 3% of their accuracy
- * (triangletest) for up to 24% less Phase One.  (256 measured better
- * still on the engine, 1.84% / 1.19%, but only because its error offset
- * the first bounce's shortfall of the time, since mended by a model's finer
- * triangle grids; with them, 256 gives 1.85% / 1.26% against 1.70% /
- * 1.06%.) */
+ * (triangletest) for up to 24% less Phase One.  With a model's triangles
+ * at h/2, 256 for E_2 gives 1.85% / 1.26% against 512's 1.70% / 1.06%. */
 #define MIN_CUT 128
 static int level_max_cut(int level)
 {

@@ -75,8 +75,7 @@ static double seen_share(gather *g, const sender_node *node)
         for (int i = first; i < first + node->count; i++)
             any |= faces(g, &t->elems[i]);
         for (int i = first; i < first + node->count; i++) {
-            const float *b = &t->elem_radiance[3 * (size_t)i];
-            double w = (0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2]) * t->elems[i].area;
+            double w = sender_elem_power(t, i);
             const float *c = t->elems[i].c;
             if (any && !faces(g, &t->elems[i]))
                 continue;

@@ -143,14 +143,6 @@ typedef struct builder {
 static int build_nodes(sender_tree *t);
 static void fill_node(sender_tree *t, int32_t ni);
 
-/* Element i's share of its cluster's power: the luminance of its
- * radiance times its area. */
-static double elem_power(const sender_tree *t, int32_t i)
-{
-    const float *b = &t->elem_radiance[3 * (size_t)i];
-    return (0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2]) * t->elems[i].area;
-}
-
 /* A fixed number in [0, 1) for node ni (splitmix64). */
 static double rep_number(int32_t ni)
 {
@@ -447,8 +439,7 @@ static void fill_node(sender_tree *t, int32_t ni)
                     af[2 * a + 1][ch] += f * fmax(0.0, -e->n[a]);
                 }
             }
-            double lum = 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2];
-            double w = lum * e->area;
+            double w = sender_elem_power(t, i);
             p += w;
             for (int a = 0; a < 3; a++)
                 c[a] += w * e->c[a];
@@ -489,10 +480,10 @@ static void fill_node(sender_tree *t, int32_t ni)
         int first = -1 - node->left, best = -1, last = first;
         double total = 0;
         for (int i = first; i < first + node->count; i++)
-            total += elem_power(t, i);
+            total += sender_elem_power(t, i);
         double acc = 0, aim = u * total;
         for (int i = first; i < first + node->count && best < 0; i++) {
-            double w = elem_power(t, i);
+            double w = sender_elem_power(t, i);
             acc += w;
             if (w > 0) {
                 last = i;

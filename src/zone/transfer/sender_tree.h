@@ -101,4 +101,12 @@ void sender_tree_free(sender_tree *t);
  * element with none live sends nothing). */
 void sender_tree_fill(sender_tree *t, const surface_nodes *sn, const rscene *rs, const float *e);
 
+/* Element i's power in the level filled last: the luminance of its
+ * radiance times its area. */
+static inline double sender_elem_power(const sender_tree *t, int32_t i)
+{
+    const float *b = &t->elem_radiance[3 * (size_t)i];
+    return (0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2]) * t->elems[i].area;
+}
+
 #endif
