@@ -22,6 +22,7 @@
 #include "util/error.h"
 #include "util/vec3_convert.h"
 #include "zone/maps/mesh_rounds.h"
+#include "zone/maps/node_twins.h"
 #include "zone/phase_one/caustic.h"
 #include "zone/phase_one/glint.h"
 #include "zone/phase_one/node_life.h"
@@ -197,8 +198,8 @@ static int level_max_cut(int level)
  * passes `until` or the render is asked to stop (on any process), the level
  * is abandoned: *abandoned is set and nothing changes. */
 static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
-                             const sender_tree *tree, const mesh_rounds *mr, double until,
-                             int *abandoned, zt_error *err)
+                             const sender_tree *tree, const mesh_rounds *mr,
+                             const node_twins *tw, double until, int *abandoned, zt_error *err)
 {
     const rscene *rs = &r->rs;
     const surface_nodes *sn = &f->sn;
@@ -247,11 +248,17 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
             /* (Direct light keeps every vertex: its shadows are sharp, and
              * it costs little.) */
             int vertex = !fine && level > 0 ? mesh_round(mr, k) : 0;
-            if ((fine ? fine : vertex) != pass)
+            /* A twin's node is computed in the first pass (a mesh
+             * triangle's grid node), and read in the next. */
+            int32_t twin = node_twin(tw, k);
+            if ((twin >= 0 ? 1 : fine ? fine : vertex) != pass)
                 continue;
             vec3 e;
             float read[3];
-            if (fine && straight(sn, v, line, pos, &w)) {
+            if (twin >= 0) {
+                const float *b = &v[3 * (size_t)twin];
+                e = v3(b[0], b[1], b[2]);
+            } else if (fine && straight(sn, v, line, pos, &w)) {
                 const float *b = &v[3 * (size_t)line[1]], *c = &v[3 * (size_t)line[2]];
                 e = v3((1 - w) * b[0] + w * c[0], (1 - w) * b[1] + w * c[1],
                        (1 - w) * b[2] + w * c[2]);
@@ -330,9 +337,15 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
         mesh_rounds mr;
         if (!mesh_rounds_build(&mr, &f->sn, &r->rs, render_thread_count(r->options.threads)))
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the mesh's node rounds");
+        node_twins tw;
+        if (!node_twins_build(&tw, &f->sn, &r->rs)) {
+            mesh_rounds_free(&mr);
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the mesh's node twins");
+        }
         sender_tree tree;
         if (!sender_tree_build(&tree, &f->sn, &r->rs)) {
             mesh_rounds_free(&mr);
+            node_twins_free(&tw);
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the sender tree");
         }
         /* Levels are built while they fit before the deadline, less the
@@ -344,7 +357,8 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
             if (level > 0)
                 sender_tree_fill(&tree, &f->sn, &r->rs, zone_e(f, level - 1, 0));
             int abandoned = 0;
-            st = build_level(f, r, level, &tree, &mr, r->deadline - phase_two, &abandoned, err);
+            st = build_level(f, r, level, &tree, &mr, &tw, r->deadline - phase_two, &abandoned,
+                             err);
             if (st != ZT_OK)
                 break;
             if (abandoned) {
@@ -358,6 +372,7 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
         }
         sender_tree_free(&tree);
         mesh_rounds_free(&mr);
+        node_twins_free(&tw);
         if (st != ZT_OK)
             return st;
         if (built < f->map_levels) {
