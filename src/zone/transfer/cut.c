@@ -54,10 +54,9 @@ static float lumf(const float v[3])
 
 /* Whether element e's sending side faces the receiver (an element facing
  * away is hidden by its own surface, whatever its cluster does). */
-static int faces(const gather *g, const sender_elem *e)
+static int faces(const gather *g, const float c[3], const float n[3])
 {
-    return e->n[0] * (g->xf.x - e->c[0]) + e->n[1] * (g->xf.y - e->c[1]) +
-               e->n[2] * (g->xf.z - e->c[2]) > 0;
+    return n[0] * (g->xf.x - c[0]) + n[1] * (g->xf.y - c[1]) + n[2] * (g->xf.z - c[2]) > 0;
 }
 
 /* The share of a cluster's power a ray reaches: rays to its two children's
@@ -73,11 +72,11 @@ static double seen_share(gather *g, const sender_node *node)
     if (node->count > 0) {
         int first = -1 - node->left, any = 0;
         for (int i = first; i < first + node->count; i++)
-            any |= faces(g, &t->elems[i]);
+            any |= faces(g, t->elems[i].c, t->elems[i].n);
         for (int i = first; i < first + node->count; i++) {
             double w = sender_elem_power(t, i);
             const float *c = t->elems[i].c;
-            if (any && !faces(g, &t->elems[i]))
+            if (any && !faces(g, t->elems[i].c, t->elems[i].n))
                 continue;
             wsum += w;
             if (w > 0)
@@ -111,7 +110,7 @@ static double seen_share(gather *g, const sender_node *node)
         int facing[2 << SEEN_DEPTH], any = 0;
         for (int k = 0; k < nk; k++) {
             const sender_light *cl = &t->light[kids[k]];
-            facing[k] = faces(g, &t->elems[cl->rep_elem]);
+            facing[k] = faces(g, cl->rep, cl->rep_n);
             any |= facing[k] && cl->power > 0;
         }
         for (int k = 0; k < nk; k++) {
@@ -206,12 +205,10 @@ static void evaluate(gather *g, int32_t ni, cand *out)
     int facing = ca > 0 && cb > 0 && ca * cb - sa * sb > 0;
     float k = cos_r / r2;
     for (int ch = 0; ch < 3; ch++) {
-        float dot;
-        if (facing)
-            dot = l->vflux[ch][0] * u.x + l->vflux[ch][1] * u.y + l->vflux[ch][2] * u.z;
-        else
-            dot = fabsf(u.x) * l->aflux[u.x < 0][ch] + fabsf(u.y) * l->aflux[2 + (u.y < 0)][ch] +
-                  fabsf(u.z) * l->aflux[4 + (u.z < 0)][ch];
+        float dot = l->vflux[ch][0] * u.x + l->vflux[ch][1] * u.y + l->vflux[ch][2] * u.z;
+        if (!facing)
+            dot = 0.5f * (dot + fabsf(u.x) * l->aflux[ch][0] + fabsf(u.y) * l->aflux[ch][1] +
+                          fabsf(u.z) * l->aflux[ch][2]);
         out->est[ch] = f_max0(dot) * k;
     }
 }

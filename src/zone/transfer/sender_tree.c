@@ -314,8 +314,10 @@ static int build_nodes(sender_tree *t)
     int k = t->elem_count;
     for (int i = 0; i < k; i++)
         t->total_area += t->elems[i].area;
-    t->nodes = malloc((2 * (size_t)k + 1) * sizeof *t->nodes);
-    t->light = calloc(2 * (size_t)k + 1, sizeof *t->light);
+    t->nodes = aligned_alloc(_Alignof(sender_node), (2 * (size_t)k + 1) * sizeof *t->nodes);
+    t->light = aligned_alloc(_Alignof(sender_light), (2 * (size_t)k + 1) * sizeof *t->light);
+    if (t->light)
+        memset(t->light, 0, (2 * (size_t)k + 1) * sizeof *t->light);
     t->elem_radiance = calloc(3 * (size_t)k + 3, sizeof(float));
     if (!t->nodes || !t->light || !t->elem_radiance)
         return 0;
@@ -424,7 +426,7 @@ static void fill_node(sender_tree *t, int32_t ni)
 {
     sender_node *node = &t->nodes[ni];
     sender_light *l = &t->light[ni];
-    double flux[3] = {0, 0, 0}, v[3][3] = {{0}}, af[6][3] = {{0}}, c[3] = {0, 0, 0}, p = 0;
+    double v[3][3] = {{0}}, af[3][3] = {{0}}, c[3] = {0, 0, 0}, p = 0;
     if (node->count > 0) {
         int first = -1 - node->left;
         for (int i = first; i < first + node->count; i++) {
@@ -432,11 +434,9 @@ static void fill_node(sender_tree *t, int32_t ni)
             const float *b = &t->elem_radiance[3 * (size_t)i];
             for (int ch = 0; ch < 3; ch++) {
                 double f = (double)b[ch] * e->area;
-                flux[ch] += f;
                 for (int a = 0; a < 3; a++) {
                     v[ch][a] += f * e->n[a];
-                    af[2 * a][ch] += f * fmax(0.0, e->n[a]);
-                    af[2 * a + 1][ch] += f * fmax(0.0, -e->n[a]);
+                    af[ch][a] += f * fabs(e->n[a]);
                 }
             }
             double w = sender_elem_power(t, i);
@@ -449,25 +449,21 @@ static void fill_node(sender_tree *t, int32_t ni)
         fill_node(t, node->left + 1);
         for (int k = 0; k < 2; k++) {
             const sender_light *cl = &t->light[node->left + k];
-            for (int ch = 0; ch < 3; ch++) {
-                flux[ch] += cl->flux[ch];
-                for (int a = 0; a < 3; a++)
+            for (int ch = 0; ch < 3; ch++)
+                for (int a = 0; a < 3; a++) {
                     v[ch][a] += cl->vflux[ch][a];
-                for (int a = 0; a < 6; a++)
-                    af[a][ch] += cl->aflux[a][ch];
-            }
+                    af[ch][a] += cl->aflux[ch][a];
+                }
             p += cl->power;
             for (int a = 0; a < 3; a++)
                 c[a] += (double)cl->power * cl->c[a];
         }
     }
-    for (int ch = 0; ch < 3; ch++) {
-        l->flux[ch] = (float)flux[ch];
-        for (int a = 0; a < 3; a++)
+    for (int ch = 0; ch < 3; ch++)
+        for (int a = 0; a < 3; a++) {
             l->vflux[ch][a] = (float)v[ch][a];
-        for (int a = 0; a < 6; a++)
-            l->aflux[a][ch] = (float)af[a][ch];
-    }
+            l->aflux[ch][a] = (float)af[ch][a];
+        }
     l->power = (float)p;
     for (int a = 0; a < 3; a++)
         l->c[a] = p > 0 ? (float)(c[a] / p) : 0.5f * (node->lo[a] + node->hi[a]);
@@ -493,15 +489,17 @@ static void fill_node(sender_tree *t, int32_t ni)
         }
         if (best < 0)
             best = last; /* rounding, or no element with light */
-        for (int a = 0; a < 3; a++)
+        for (int a = 0; a < 3; a++) {
             l->rep[a] = t->elems[best].c[a];
-        l->rep_elem = best;
+            l->rep_n[a] = t->elems[best].n[a];
+        }
     } else {
         const sender_light *L = &t->light[node->left], *R = &t->light[node->left + 1];
         const sender_light *pick = u * ((double)L->power + R->power) < L->power ? L : R;
-        for (int a = 0; a < 3; a++)
+        for (int a = 0; a < 3; a++) {
             l->rep[a] = pick->rep[a];
-        l->rep_elem = pick->rep_elem;
+            l->rep_n[a] = pick->rep_n[a];
+        }
     }
 }
 

@@ -35,8 +35,11 @@ typedef struct sender_elem {
                            radiance leaving per unit irradiance */
 } sender_elem;
 
+/* One cache line (64 bytes, so aligned): a cut reads a node's whole
+ * record for every cluster it weighs, from all over the tree. */
 typedef struct sender_node {
-    float lo[3], hi[3];
+    _Alignas(64) float lo[3];
+    float hi[3];
     float axis[3];      /* normal cone: every element normal lies within */
     float cone;         /* this angle (radians) of axis; > pi/2: any */
     float cos_cone, sin_cone;
@@ -48,28 +51,33 @@ typedef struct sender_node {
     int16_t any_way;    /* some element sends every way (a sphere light) */
 } sender_node;
 
-/* One level's light in a cluster: flux (rgb, radiance x area summed),
- * the vector flux per channel (radiance x area x normal: for a receiver
- * every element faces, the sum of flux x cosine is this dotted with the
- * direction), its luminance and the luminance-weighted centroid. */
+/* One level's light in a cluster, two cache lines (128 bytes, so
+ * aligned); the first holds what a cut reads for every cluster it weighs:
+ * the luminance of the flux (radiance x area summed), the
+ * luminance-weighted centroid, and the vector flux per channel (radiance x
+ * area x normal: for a receiver every element faces, the sum of flux x
+ * cosine is this dotted with the direction). */
 typedef struct sender_light {
-    float flux[3];
-    float vflux[3][3];  /* [channel][axis] */
-    /* For clusters whose elements do not all face a receiver: the flux of
-     * the elements' normal components along each signed axis (+x, -x, +y,
-     * ...), flux x max(0, +-n_a); sum_a |w_a| aflux[sign w_a, a] is flux x
-     * cosine exactly for elements facing along axes (a room's walls), and
-     * never below it for others. */
-    float aflux[6][3];  /* [signed axis][channel] */
-    float power;        /* luminance of flux */
+    _Alignas(64) float power;
     float c[3];
+    float vflux[3][3];  /* [channel][axis] */
     /* Where the cluster is seen from: the centroid of one of its
      * elements, drawn in proportion to power by a fixed number per node
      * (a child by its share of the power, down to an element).
      * Visibility is tested there, not at the centroid, which may lie
      * inside an object the cluster's elements surround. */
     float rep[3];
-    int32_t rep_elem;   /* the element rep is the centre of */
+    /* The normal of the side rep's element sends from: whether it faces
+     * a receiver. */
+    float rep_n[3];
+    /* For clusters whose elements do not all face a receiver: the flux
+     * times the magnitude of each normal component, sum flux |n_a|.  Half
+     * of it plus or minus half the vector flux is the flux of the
+     * elements' normal components along each signed axis, so
+     * (|w| . aflux + w . vflux) / 2 is flux x cosine exactly for elements
+     * facing along axes (a room's walls), and never below it for
+     * others. */
+    float aflux[3][3];  /* [channel][axis] */
 } sender_light;
 
 typedef struct sender_tree {
