@@ -21,6 +21,8 @@ typedef struct cand {
     float err;          /* bound on the luminance it may contribute */
     float est[3];       /* its estimate, in the total */
     int32_t node;
+    int32_t left;       /* the node's (sender_node): its children or */
+    int32_t count;      /* elements, without reading it again */
     int32_t seen;       /* visibility taken into est (else unoccluded) */
 } cand;
 
@@ -134,6 +136,8 @@ static void evaluate(gather *g, int32_t ni, cand *out)
     const sender_node *node = &t->nodes[ni];
     const sender_light *l = &t->light[ni];
     out->node = ni;
+    out->left = node->left;
+    out->count = node->count;
     out->est[0] = out->est[1] = out->est[2] = 0;
     out->err = 0;
     out->seen = 0;
@@ -298,12 +302,21 @@ vec3 cut_gather(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo
             break;
         }
         cand top = heap_pop(heap, &hn);
+        /* The next clusters to open are near the heap's top: their
+         * children's records, from anywhere in the tree, are fetched while
+         * this one's are weighed. */
+        for (int h = 0; h < 3 && h < hn; h++)
+            if (heap[h].count == 0) {
+                __builtin_prefetch(&t->nodes[heap[h].left]);
+                __builtin_prefetch(&t->nodes[heap[h].left + 1]);
+                __builtin_prefetch(&t->light[heap[h].left]);
+                __builtin_prefetch(&t->light[heap[h].left + 1]);
+            }
         for (int ch = 0; ch < 3; ch++)
             total[ch] -= top.est[ch];
-        const sender_node *node = &t->nodes[top.node];
-        if (node->count > 0) {
-            int first = -1 - node->left;
-            for (int i = first; i < first + node->count; i++) {
+        if (top.count > 0) {
+            int first = -1 - top.left;
+            for (int i = first; i < first + top.count; i++) {
                 st->clusters++;
                 c->leaf(c->user, i, x, n, exact, st);
             }
@@ -312,7 +325,7 @@ vec3 cut_gather(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo
         cut++;
         for (int k = 0; k < 2; k++) {
             cand ch;
-            evaluate(&g, node->left + k, &ch);
+            evaluate(&g, top.left + k, &ch);
             if (!(ch.err > 0) && !(lumf(ch.est) > 0))
                 continue;
             for (int q = 0; q < 3; q++)
