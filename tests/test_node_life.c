@@ -1,7 +1,8 @@
 /* Node life (zone/phase_one/node_life.h): a model's vertices sunk behind a
  * wall are raised to where their triangles come out of it.  A smooth OBJ
  * sheet stands upright on the floor with its two lowest rows of vertices
- * below it; the zone tracer's own nodes for the scene are checked.
+ * below it; the zone tracer's own nodes for the scene are checked, and
+ * again after its forest is written and read back.
  *
  * Needs nothing from ../shared. */
 #include "test_support.h"
@@ -23,8 +24,8 @@
 #define BOTTOM -15.0 /* rows at y = -15 and -5 lie below the floor */
 #define SHEET_Z 50.0
 
-/* Vertex (i, j) at x = STEP j, y = BOTTOM + STEP i, facing -z. */
-static const char *write_sheet(void)
+/* Vertex (i, j) at x = STEP j, y = bottom + step_y i, facing -z. */
+static const char *write_sheet(double step_y, double bottom)
 {
     size_t cap = (ROWS + 1) * (COLS + 1) * 64 + ROWS * COLS * 64 + 64;
     char *text = malloc(cap);
@@ -33,7 +34,7 @@ static const char *write_sheet(void)
     for (int i = 0; i <= ROWS; i++)
         for (int j = 0; j <= COLS; j++)
             len += (size_t)snprintf(text + len, cap - len, "v %g %g %g\n", STEP * j,
-                                    BOTTOM + STEP * i, SHEET_Z);
+                                    bottom + step_y * i, SHEET_Z);
     for (int i = 0; i < ROWS; i++)
         for (int j = 0; j < COLS; j++) {
             int a = i * (COLS + 1) + j + 1, b = a + 1, c = a + COLS + 1, d = c + 1;
@@ -47,13 +48,11 @@ static const char *write_sheet(void)
     return path;
 }
 
-/* The vertices of the row just below the floor are live and lie a hair
- * above it, straight over where they were (the vertical edge reaches the
- * floor first); the row below them, with no live corner beside it, stays
- * dead; the rows above are where the model has them. */
-static void test_sunk_vertices_are_raised(void **state)
+/* The sheet on the floor under a light, rendered with the zone tracer at
+ * depth 2.  A small triangle at (far, 0, far) sets the node spacing (the
+ * scene's size / 40). */
+static zt_renderer *render_sheet(double step_y, double bottom, double far, zt_scene **scene_out)
 {
-    (void)state;
     char text[2048];
     snprintf(text, sizeof text,
              "{\"camera\": {\"position\": [50, 40, -150], \"lookat\": [50, 20, 50], "
@@ -61,13 +60,11 @@ static void test_sunk_vertices_are_raised(void **state)
              "{\"light\": {\"emission\": [20, 20, 20], \"backculled\": true, \"parts\": ["
              "{\"lighttriangle\": {\"points\": [[30, 150, 0], [70, 150, 30], [70, 150, 0]]}}]}},"
              "{\"plane\": {\"normal\": [0, 1, 0], \"offset\": 0, " TEST_DIFFUSE(0.5) "}},"
-             /* Far off, so that the node spacing (the scene's size / 40)
-              * leaves the sheet's triangles their corners alone. */
              "{\"thing\": {" TEST_DIFFUSE(0.5) ", \"parts\": [{\"triangle\": {\"points\": "
-             "[[1000, 0, 1000], [1001, 0, 1000], [1000, 1, 1000]]}}]}},"
+             "[[%g, 0, %g], [%g, 0, %g], [%g, 1, %g]]}}]}},"
              "{\"mesh\": {\"file\": \"%s\", \"smooth\": true, \"backculled\": true, " TEST_DIFFUSE(
                  0.5) "}}]}",
-             write_sheet());
+             far, far, far + 1, far, far, far, write_sheet(step_y, bottom));
     zt_scene *scene = test_scene_text(text, "sunk_sheet.json");
     zt_render_options o = zt_render_options_default();
     o.method = ZT_METHOD_ZONE;
@@ -82,7 +79,20 @@ static void test_sunk_vertices_are_raised(void **state)
     if (zt_renderer_accumulate(r, 0, 1, img, NULL, &err) != ZT_OK)
         fail_msg("accumulate: %s", err.message);
     zt_image_release(img);
+    *scene_out = scene;
+    return r;
+}
 
+/* The vertices of the row just below the floor are live and lie a hair
+ * above it, straight over where they were (the vertical edge reaches the
+ * floor first); the row below them, with no live corner beside it, stays
+ * dead; the rows above are where the model has them. */
+static void test_sunk_vertices_are_raised(void **state)
+{
+    (void)state;
+    zt_scene *scene;
+    /* The spacing leaves the sheet's triangles their corners alone. */
+    zt_renderer *r = render_sheet(STEP, BOTTOM, 1000, &scene);
     const surface_nodes *sn = &r->forest->sn;
     assert_int_equal(sn->mesh_count, 1);
     assert_true(sn->vertex_first[0] >= 0);
@@ -119,10 +129,50 @@ static void test_sunk_vertices_are_raised(void **state)
     zt_scene_release(scene);
 }
 
+/* A forest keeps its raised vertices: written and read back, its nodes are
+ * where they were raised to.  Rows 20 apart, the lowest 8 below the floor,
+ * and a spacing of about 24 (the triangles split in two along each edge):
+ * the lowest vertices are raised by about 8, farther than the quarter
+ * cell node life moves any other node, which the file's check once allowed
+ * alone. */
+static void test_raised_vertices_survive_the_forest_file(void **state)
+{
+    (void)state;
+    zt_scene *scene;
+    zt_renderer *r = render_sheet(20, -8, 680, &scene);
+    const surface_nodes *sn = &r->forest->sn;
+    const rs_mesh *mm = &r->rs.meshes[0];
+    float moved = 0;
+    for (int v = 0; v < mm->m->vertex_count; v++) {
+        int32_t k = sn->vertex_first[0] + v;
+        moved = fmaxf(moved, fabsf(sn->pos[3 * k + 1] - mm->m->position[3 * (size_t)v + 1]));
+    }
+    printf("a vertex raised by %.2f, node spacing %.2f\n", moved, sn->h);
+    assert_true(moved > 0.3 * sn->h);
+
+    zt_error err = {0};
+    const char *forest = test_tmp_path("sunk_sheet.forest");
+    if (zt_renderer_save_forest(r, forest, &err) != ZT_OK)
+        fail_msg("save forest: %s", err.message);
+    zt_render_options o = r->options;
+    o.forest_file = forest;
+    zt_renderer *back = NULL;
+    if (zt_renderer_create(scene, &o, &back, &err) != ZT_OK)
+        fail_msg("load forest: %s", err.message);
+    const surface_nodes *bn = &back->forest->sn;
+    assert_int_equal(bn->node_count, sn->node_count);
+    assert_memory_equal(bn->live, sn->live, (size_t)sn->node_count);
+    assert_memory_equal(bn->pos, sn->pos, 3 * (size_t)sn->node_count * sizeof *sn->pos);
+    zt_renderer_release(back);
+    zt_renderer_release(r);
+    zt_scene_release(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sunk_vertices_are_raised),
+        cmocka_unit_test(test_raised_vertices_survive_the_forest_file),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
