@@ -108,7 +108,9 @@ static double hit_prim(const zprim *p, vec3 o, vec3 d, double tmax, int *back)
     }
 }
 
-static int slab(const occ_node *b, vec3 o, vec3 inv, double tmax)
+/* The distance at which ray (o, 1 / inv) enters box b before tmax, or -1
+ * when it misses it. */
+static double slab(const occ_node *b, vec3 o, vec3 inv, double tmax)
 {
     double t0 = 0, t1 = tmax;
     double oo[3] = {o.x, o.y, o.z}, ii[3] = {inv.x, inv.y, inv.z};
@@ -122,9 +124,9 @@ static int slab(const occ_node *b, vec3 o, vec3 inv, double tmax)
         t0 = fmax(t0, u);
         t1 = fmin(t1, v * 1.0000001);
         if (t0 > t1)
-            return 0;
+            return -1;
     }
-    return 1;
+    return t0;
 }
 
 /* The nearest hit of ray (o, d) closer than tmax (node_life_first_hit);
@@ -151,13 +153,20 @@ static int first_hit(const occluder_index *occ, const zt_scene *scene, const rsc
     if (occ->prim_count == 0)
         return found;
     vec3 inv = v3(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+    /* Nearer child first, each with the distance it is entered at: a box
+     * entered beyond the nearest hit so far is skipped. */
     int32_t stack[128];
+    double enter[128];
     int sp = 0;
-    stack[sp++] = 0;
+    if (slab(&occ->nodes[0], o, inv, best) >= 0) {
+        stack[sp] = 0;
+        enter[sp++] = 0;
+    }
     while (sp > 0) {
-        const occ_node *node = &occ->nodes[stack[--sp]];
-        if (!slab(node, o, inv, best))
+        sp--;
+        if (enter[sp] > best)
             continue;
+        const occ_node *node = &occ->nodes[stack[sp]];
         if (node->count > 0) {
             int first = -1 - node->left;
             for (int k = 0; k < node->count; k++) {
@@ -174,8 +183,24 @@ static int first_hit(const occluder_index *occ, const zt_scene *scene, const rsc
                 }
             }
         } else if (sp + 2 <= 128) {
-            stack[sp++] = node->left + 1;
-            stack[sp++] = node->left;
+            double tl = slab(&occ->nodes[node->left], o, inv, best);
+            double tr = slab(&occ->nodes[node->left + 1], o, inv, best);
+            int near = node->left, far = node->left + 1;
+            if (tr >= 0 && (tl < 0 || tr < tl)) {
+                double w = tl;
+                tl = tr;
+                tr = w;
+                near = node->left + 1;
+                far = node->left;
+            }
+            if (tr >= 0) {
+                stack[sp] = far;
+                enter[sp++] = tr;
+            }
+            if (tl >= 0) {
+                stack[sp] = near;
+                enter[sp++] = tl;
+            }
         }
     }
     *dist = best;
