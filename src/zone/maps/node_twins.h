@@ -6,8 +6,11 @@
  * Two triangles across an edge whose grids put a node at the same fraction
  * of it (the same steps, or steps a multiple of each other) thus have a
  * node each at the same point, with the same normal (interpolated between
- * the same two vertex normals).  Their light is the same: one of them is
- * computed and the other takes its value. */
+ * the same two vertex normals).  One of them is computed and the other
+ * takes its value.  Computed each on its own triangle they differed only
+ * in the occluders of the exact direct light, which are chosen per
+ * triangle: on the N-series spheres taking one for both moved the error by
+ * at most 0.004 points, and the engine room's not at all. */
 #ifndef ZT_ZONE_MAPS_NODE_TWINS_H
 #define ZT_ZONE_MAPS_NODE_TWINS_H
 
