@@ -48,7 +48,7 @@ static const char *write_sheet(double step_y, double bottom)
     return path;
 }
 
-/* The sheet on the floor under a light, rendered with the zone tracer at
+/* The sheet on the floor under a light, with the zone tracer's forest of
  * depth 2.  A small triangle at (far, 0, far) sets the node spacing (the
  * scene's size / 40). */
 static zt_renderer *render_sheet(double step_y, double bottom, double far, zt_scene **scene_out)
@@ -66,19 +66,7 @@ static zt_renderer *render_sheet(double step_y, double bottom, double far, zt_sc
                  0.5) "}}]}",
              far, far, far + 1, far, far, far, write_sheet(step_y, bottom));
     zt_scene *scene = test_scene_text(text, "sunk_sheet.json");
-    zt_render_options o = zt_render_options_default();
-    o.method = ZT_METHOD_ZONE;
-    o.depth = 2;
-    o.threads = 2;
-    zt_renderer *r = NULL;
-    zt_error err = {0};
-    if (zt_renderer_create(scene, &o, &r, &err) != ZT_OK)
-        fail_msg("renderer: %s", err.message);
-    zt_image *img = zt_image_create(8, 8);
-    assert_non_null(img);
-    if (zt_renderer_accumulate(r, 0, 1, img, NULL, &err) != ZT_OK)
-        fail_msg("accumulate: %s", err.message);
-    zt_image_release(img);
+    zt_renderer *r = test_zone_renderer(scene, 2, 2, zt_render_options_default().quality);
     *scene_out = scene;
     return r;
 }

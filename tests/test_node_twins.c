@@ -59,19 +59,7 @@ static void test_edge_nodes_are_paired(void **state)
                  0.5) "}}]}",
              write_sheet());
     zt_scene *scene = test_scene_text(text, "twin_sheet.json");
-    zt_render_options o = zt_render_options_default();
-    o.method = ZT_METHOD_ZONE;
-    o.depth = 2;
-    o.threads = 2;
-    zt_renderer *r = NULL;
-    zt_error err = {0};
-    if (zt_renderer_create(scene, &o, &r, &err) != ZT_OK)
-        fail_msg("renderer: %s", err.message);
-    zt_image *img = zt_image_create(8, 8);
-    assert_non_null(img);
-    if (zt_renderer_accumulate(r, 0, 1, img, NULL, &err) != ZT_OK)
-        fail_msg("accumulate: %s", err.message);
-    zt_image_release(img);
+    zt_renderer *r = test_zone_renderer(scene, 2, 2, zt_render_options_default().quality);
 
     const surface_nodes *sn = &r->forest->sn;
     const rscene *rs = &r->rs;

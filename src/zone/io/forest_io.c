@@ -18,42 +18,7 @@
 #include "scene/scene_hash.h"
 #include "util/fnv1a.h"
 #include "util/error.h"
-
-/* How far node life may have moved each node (node_life.c), per axis: a
- * node on a seam between walls a quarter cell into the room, a model's
- * sunk vertex along an edge of one of its triangles, at most the longest.
- * NULL when out of memory. */
-static float *node_reach(const surface_nodes *sn, const rscene *rs)
-{
-    float *reach = malloc(((size_t)sn->node_count + 1) * sizeof *reach);
-    if (!reach)
-        return NULL;
-    for (int k = 0; k < sn->node_count; k++)
-        reach[k] = (float)(0.3 * sn->h);
-    for (int mi = 0; mi < sn->mesh_count && mi < rs->mesh_count; mi++) {
-        if (sn->vertex_first[mi] < 0)
-            continue;
-        const mesh *m = rs->meshes[mi].m;
-        int sides = rs->meshes[mi].culled ? 1 : 2;
-        for (int t = 0; t < m->triangle_count; t++)
-            for (int c = 0; c < 3; c++) {
-                uint32_t v = m->index[3 * (size_t)t + c], w = m->index[3 * (size_t)t + (c + 1) % 3];
-                float d2 = 0;
-                for (int a = 0; a < 3; a++) {
-                    float d = m->position[3 * (size_t)v + a] - m->position[3 * (size_t)w + a];
-                    d2 += d * d;
-                }
-                float d = sqrtf(d2);
-                for (int s = 0; s < sides; s++) {
-                    float *rv = &reach[sn->vertex_first[mi] + s * m->vertex_count + (int32_t)v];
-                    float *rw = &reach[sn->vertex_first[mi] + s * m->vertex_count + (int32_t)w];
-                    *rv = d > *rv ? d : *rv;
-                    *rw = d > *rw ? d : *rw;
-                }
-            }
-    }
-    return reach;
-}
+#include "zone/phase_one/node_life.h"
 
 static const char MAGIC[8] = {'Z', 'T', 'F', 'O', 'R', 'E', 'S', 'T'};
 #define BYTE_ORDER_MARK 0x01020304u
@@ -607,7 +572,7 @@ zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *
             st = ZT_ERR_PARSE;
             goto done;
         }
-        float *reach = node_reach(&f->sn, &r->rs);
+        float *reach = node_life_reach(&f->sn, &r->rs);
         if (!reach) {
             free(pos);
             st = zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");

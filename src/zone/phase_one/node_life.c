@@ -363,3 +363,31 @@ uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_s
     free(walls);
     return rays + raise_sunk_vertices(sn, occ, scene, rs);
 }
+
+float *node_life_reach(const surface_nodes *sn, const rscene *rs)
+{
+    float *reach = malloc(((size_t)sn->node_count + 1) * sizeof *reach);
+    if (!reach)
+        return NULL;
+    for (int k = 0; k < sn->node_count; k++)
+        reach[k] = (float)(0.3 * sn->h);
+    for (int mi = 0; mi < sn->mesh_count && mi < rs->mesh_count; mi++) {
+        if (sn->vertex_first[mi] < 0)
+            continue;
+        const mesh *m = rs->meshes[mi].m;
+        int sides = rs->meshes[mi].culled ? 1 : 2;
+        for (int t = 0; t < m->triangle_count; t++)
+            for (int c = 0; c < 3; c++) {
+                uint32_t v = m->index[3 * (size_t)t + c];
+                uint32_t w = m->index[3 * (size_t)t + (c + 1) % 3];
+                float d = f3_length(
+                    f3_sub(rs_mesh_vertex(&rs->meshes[mi], v), rs_mesh_vertex(&rs->meshes[mi], w)));
+                for (int s = 0; s < sides; s++) {
+                    int32_t base = sn->vertex_first[mi] + s * m->vertex_count;
+                    reach[base + (int32_t)v] = fmaxf(reach[base + (int32_t)v], d);
+                    reach[base + (int32_t)w] = fmaxf(reach[base + (int32_t)w], d);
+                }
+            }
+    }
+    return reach;
+}

@@ -21,6 +21,13 @@
 uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_scene *scene,
                         const rscene *rs, int threads);
 
+/* How far node_life_mark may move each node from where the layout puts
+ * it, a bound on each coordinate: a node on a wall's plane a quarter cell,
+ * a model's sunk vertex along an edge of one of its triangles, at most the
+ * longest.  A forest file's nodes are checked against it.  NULL when out
+ * of memory; the caller frees it. */
+float *node_life_reach(const surface_nodes *sn, const rscene *rs);
+
 /* The nearest hit of ray (o, d) among occ's primitives and the scene's
  * planes, ignoring back-face culling: its primitive (-1: none), and
  * whether the ray meets its back (*back). */
