@@ -24,12 +24,15 @@ static inline vec3f f3_normalize(vec3f a)
     float l = f3_length(a);
     return l > 0.0f ? f3_scale(a, 1.0f / l) : a;
 }
-/* max(x, 0), min(max(x, 0), 1) and the largest component as comparisons,
- * which the compiler inlines: fmaxf is a library call without
- * -ffast-math, and a call in the hot loop spills every float register.
- * NaN gives 0 in the first two, as with fmaxf. */
+/* max(x, 0), min(max(x, 0), 1), min(max(x, -1), 1), max(a, b) and the
+ * largest component as comparisons, which the compiler inlines: fmaxf is a
+ * library call without -ffast-math, and a call in the hot loop spills
+ * every float register.  A NaN x gives the lower end of the clamps, as
+ * with fmaxf, and a NaN b in f_max a. */
 static inline float f_max0(float x) { return x > 0.0f ? x : 0.0f; }
 static inline float f_clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
+static inline float f_clamp1(float x) { return x > -1.0f ? (x < 1.0f ? x : 1.0f) : -1.0f; }
+static inline float f_max(float a, float b) { return b > a ? b : a; }
 static inline float f3_max(vec3f a)
 {
     float m = a.x > a.y ? a.x : a.y;

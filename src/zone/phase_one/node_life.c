@@ -121,8 +121,10 @@ static double slab(const occ_node *b, vec3 o, vec3 inv, double tmax)
             u = v;
             v = w;
         }
-        t0 = fmax(t0, u);
-        t1 = fmin(t1, v * 1.0000001);
+        /* (Comparisons, not fmax: a call here; a NaN u or v is passed
+         * over, as fmax does.) */
+        t0 = u > t0 ? u : t0;
+        t1 = v * 1.0000001 < t1 ? v * 1.0000001 : t1;
         if (t0 > t1)
             return -1;
     }

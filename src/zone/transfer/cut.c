@@ -17,14 +17,38 @@
  * Eight rays gained nothing more. */
 #define SEEN_DEPTH 0
 
+/* A cluster in the cut.  Its bound on the luminance it may contribute
+ * (err, >= 0) and its node are packed into one key, err's bits above the
+ * node's complement: a larger key is a larger bound, ties to the lower
+ * node (a fixed order), and the heap compares one integer. */
 typedef struct cand {
-    float err;          /* bound on the luminance it may contribute */
+    uint64_t key;
     float est[3];       /* its estimate, in the total */
-    int32_t node;
     int32_t left;       /* the node's (sender_node): its children or */
     int32_t count;      /* elements, without reading it again */
     int32_t seen;       /* visibility taken into est (else unoccluded) */
 } cand;
+
+static uint64_t cand_key(float err, int32_t node)
+{
+    uint32_t bits = 0;
+    if (err > 0)
+        memcpy(&bits, &err, sizeof bits);
+    return (uint64_t)bits << 32 | (uint32_t)~(uint32_t)node;
+}
+
+static float cand_err(const cand *c)
+{
+    uint32_t bits = (uint32_t)(c->key >> 32);
+    float err;
+    memcpy(&err, &bits, sizeof err);
+    return err;
+}
+
+static int32_t cand_node(const cand *c)
+{
+    return (int32_t)~(uint32_t)c->key;
+}
 
 typedef struct gather {
     const sender_tree *t;
@@ -128,21 +152,20 @@ static double seen_share(gather *g, const sender_node *node)
     return wsum > 0 ? seen / wsum : 0;
 }
 
-/* The cone of directions from box to x, half-angle delta: sin delta =
- * radius / distance. */
-static void evaluate(gather *g, int32_t ni, cand *out)
+/* Cluster ni's estimate for the receiver into out; returns its bound.  The
+ * cone of directions from box to x, half-angle delta: sin delta = radius /
+ * distance. */
+static float estimate(gather *g, int32_t ni, cand *out)
 {
     const sender_tree *t = g->t;
     const sender_node *node = &t->nodes[ni];
     const sender_light *l = &t->light[ni];
-    out->node = ni;
     out->left = node->left;
     out->count = node->count;
     out->est[0] = out->est[1] = out->est[2] = 0;
-    out->err = 0;
     out->seen = 0;
     if (!(l->power > 0.0f))
-        return;
+        return 0;
     /* Single precision throughout: bounds and estimates, not sums. */
     vec3f lo = f3(node->lo[0], node->lo[1], node->lo[2]);
     vec3f hi = f3(node->hi[0], node->hi[1], node->hi[2]);
@@ -157,14 +180,13 @@ static void evaluate(gather *g, int32_t ni, cand *out)
     /* (A cluster on the receiver's own plane, within rounding: nothing.) */
     if (hmax <= 1e-5f * (fabsf(hmin) + 2 * radius + fabsf(lo.x - x.x) + fabsf(lo.y - x.y) +
                          fabsf(lo.z - x.z)))
-        return;
-    vec3f d = f3(f_max0(fmaxf(lo.x - x.x, x.x - hi.x)), f_max0(fmaxf(lo.y - x.y, x.y - hi.y)),
-                 f_max0(fmaxf(lo.z - x.z, x.z - hi.z)));
+        return 0;
+    vec3f d = f3(f_max0(f_max(lo.x - x.x, x.x - hi.x)), f_max0(f_max(lo.y - x.y, x.y - hi.y)),
+                 f_max0(f_max(lo.z - x.z, x.z - hi.z)));
     float dmin2 = f3_dot(d, d);
     if (!(dmin2 > 0)) {
         /* The receiver is inside the box: nothing can be bounded. */
-        out->err = INFINITY;
-        return;
+        return INFINITY;
     }
     vec3f c = f3(l->c[0], l->c[1], l->c[2]);
     vec3f w = f3_sub(x, c); /* from the cluster to the receiver */
@@ -174,7 +196,7 @@ static void evaluate(gather *g, int32_t ni, cand *out)
      * within `cone` of the axis, at angle a from w; b = cone + delta. */
     float sd = r > radius ? radius * inv_r : 1.0f, cd = sqrtf(f_max0(1.0f - sd * sd));
     vec3f ax = f3(node->axis[0], node->axis[1], node->axis[2]);
-    float ca = fminf(1.0f, fmaxf(-1.0f, f3_dot(ax, w) * inv_r)), sa = sqrtf(f_max0(1.0f - ca * ca));
+    float ca = f_clamp1(f3_dot(ax, w) * inv_r), sa = sqrtf(f_max0(1.0f - ca * ca));
     float cc = node->cos_cone, sc = node->sin_cone;
     float cb, sb;
     if (cc < 0 && sd > sc) {
@@ -186,21 +208,20 @@ static void evaluate(gather *g, int32_t ni, cand *out)
     /* cos(max(0, a - b)), and whether a - b reaches pi/2. */
     float cos_e_max = ca >= cb ? 1.0f : ca * cb + sa * sb;
     if (ca < cb && cos_e_max <= 0)
-        return; /* every element faces away */
+        return 0; /* every element faces away */
     float cos_r = -f3_dot(n, w) * inv_r;
-    float cr = fminf(1.0f, fmaxf(-1.0f, cos_r)), sr = sqrtf(f_max0(1.0f - cr * cr));
+    float cr = f_clamp1(cos_r), sr = sqrtf(f_max0(1.0f - cr * cr));
     float cos_r_max = cr >= cd ? 1.0f : f_max0(cr * cd + sr * sd);
     /* Lightcuts' bound: what the cluster could send at most. */
-    out->err = l->power * cos_e_max * cos_r_max / dmin2;
-    if (node->any_way && out->err > 0) {
+    float err = l->power * cos_e_max * cos_r_max / dmin2;
+    if (node->any_way && err > 0) {
         /* Elements facing every way (a sphere light, points): no vector
          * flux stands for them; they are opened down to the leaves. */
-        out->err = INFINITY;
-        return;
+        return INFINITY;
     }
     g->st->clusters++;
     if (!(cos_r > 0))
-        return;
+        return err;
     /* Every element facing the receiver: flux x cosine is the vector flux
      * dotted with the direction.  Otherwise elements facing away would
      * subtract: the signed axes' flux instead (sender_light). */
@@ -215,6 +236,12 @@ static void evaluate(gather *g, int32_t ni, cand *out)
                           fabsf(u.z) * l->aflux[ch][2]);
         out->est[ch] = f_max0(dot) * k;
     }
+    return err;
+}
+
+static void evaluate(gather *g, int32_t ni, cand *out)
+{
+    out->key = cand_key(estimate(g, ni, out), ni);
 }
 
 /* Visibility into a candidate's estimate (rays), once. */
@@ -225,7 +252,7 @@ static void see(gather *g, cand *c, double total[3])
     c->seen = 1;
     if (!(lumf(c->est) > 0))
         return;
-    double s = seen_share(g, &g->t->nodes[c->node]);
+    double s = seen_share(g, &g->t->nodes[cand_node(c)]);
     for (int ch = 0; ch < 3; ch++) {
         float e = (float)(c->est[ch] * s);
         total[ch] += (double)e - c->est[ch];
@@ -237,7 +264,7 @@ static void see(gather *g, cand *c, double total[3])
 /* A max-heap on err, ties to the lower node index (a fixed order). */
 static int above(const cand *a, const cand *b)
 {
-    return a->err > b->err || (a->err == b->err && a->node < b->node);
+    return a->key > b->key;
 }
 
 static void heap_push(cand *h, int *n, cand c)
@@ -288,16 +315,16 @@ vec3 cut_gather(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo
     evaluate(&g, 0, &root);
     for (int ch = 0; ch < 3; ch++)
         total[ch] = root.est[ch];
-    if (root.err > 0 || lumf(root.est) > 0)
+    if (cand_err(&root) > 0 || lumf(root.est) > 0)
         heap_push(heap, &hn, root);
     /* A cluster's rays are cast only when it may stay in the cut (its
      * bound within the limit when it is made, or at the end): about half
      * the clusters made are opened again, and their rays were wasted. */
     while (hn > 0) {
         double limit = c->eps * dmax(lum(total) + lum(exact), c->floor);
-        if (heap[0].err <= limit)
+        if (cand_err(&heap[0]) <= limit)
             break;
-        if (cut >= c->max_cut && heap[0].err < INFINITY) {
+        if (cut >= c->max_cut && cand_err(&heap[0]) < INFINITY) {
             st->capped++;
             break;
         }
@@ -326,11 +353,11 @@ vec3 cut_gather(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo
         for (int k = 0; k < 2; k++) {
             cand ch;
             evaluate(&g, top.left + k, &ch);
-            if (!(ch.err > 0) && !(lumf(ch.est) > 0))
+            if (!(cand_err(&ch) > 0) && !(lumf(ch.est) > 0))
                 continue;
             for (int q = 0; q < 3; q++)
                 total[q] += ch.est[q];
-            if (ch.err <= limit || hn >= HEAP_MAX)
+            if (cand_err(&ch) <= limit || hn >= HEAP_MAX)
                 see(&g, &ch, total);
             if (hn >= HEAP_MAX)
                 continue; /* no room: it stays as estimated (it is in) */
