@@ -77,7 +77,7 @@ static void build(builder *b, int32_t ni, int first, int n, int depth)
     for (int a = 1; a < 3; a++)
         if (chi[a] - clo[a] > chi[axis] - clo[axis])
             axis = a;
-    if (n <= LEAF_SIZE || depth > 60 || !(chi[axis] > clo[axis])) {
+    if (n <= LEAF_SIZE || depth >= OCC_MAX_DEPTH || !(chi[axis] > clo[axis])) {
         node->left = -1 - first;
         node->count = n;
         return;
@@ -165,7 +165,7 @@ int occluders_query(const occluder_index *ix, const occ_region *r, int32_t *out,
 {
     if (ix->prim_count == 0)
         return 0;
-    int32_t stack[128];
+    int32_t stack[OCC_STACK];
     int sp = 0, found = 0;
     stack[sp++] = 0;
     while (sp > 0) {
@@ -179,7 +179,7 @@ int occluders_query(const occluder_index *ix, const occ_region *r, int32_t *out,
                     out[found] = ix->prims[first + i];
                 found++;
             }
-        } else if (sp + 2 <= 128) {
+        } else {
             stack[sp++] = node->left + 1;
             stack[sp++] = node->left;
         }

@@ -12,6 +12,12 @@
 #include "render/render_scene.h"
 #include "util/vec3.h"
 
+/* The index is at most OCC_MAX_DEPTH levels below its root (deeper runs
+ * stay leaves), so a traversal that pops a node and pushes its two
+ * children never holds more than OCC_STACK entries. */
+#define OCC_MAX_DEPTH 60
+#define OCC_STACK (OCC_MAX_DEPTH + 3)
+
 typedef struct occ_node {
     float lo[3], hi[3];
     int32_t left;       /* inner: index of the left child (the right one

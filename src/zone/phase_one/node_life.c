@@ -157,8 +157,8 @@ static int first_hit(const occluder_index *occ, const zt_scene *scene, const rsc
     vec3 inv = v3(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
     /* Nearer child first, each with the distance it is entered at: a box
      * entered beyond the nearest hit so far is skipped. */
-    int32_t stack[128];
-    double enter[128];
+    int32_t stack[OCC_STACK];
+    double enter[OCC_STACK];
     int sp = 0;
     if (slab(&occ->nodes[0], o, inv, best) >= 0) {
         stack[sp] = 0;
@@ -184,7 +184,7 @@ static int first_hit(const occluder_index *occ, const zt_scene *scene, const rsc
                     *back = b;
                 }
             }
-        } else if (sp + 2 <= 128) {
+        } else {
             double tl = slab(&occ->nodes[node->left], o, inv, best);
             double tr = slab(&occ->nodes[node->left + 1], o, inv, best);
             int near = node->left, far = node->left + 1;
