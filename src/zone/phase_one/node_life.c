@@ -121,8 +121,8 @@ static double slab(const occ_node *b, vec3 o, vec3 inv, double tmax)
             u = v;
             v = w;
         }
-        /* (Comparisons, not fmax: a call here; a NaN u or v is passed
-         * over, as fmax does.) */
+        /* Comparisons rather than fmax and fmin, which are calls here; a
+         * NaN u or v is passed over, as they would. */
         t0 = u > t0 ? u : t0;
         t1 = v * 1.0000001 < t1 ? v * 1.0000001 : t1;
         if (t0 > t1)

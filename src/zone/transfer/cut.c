@@ -2,6 +2,7 @@
 #include "zone/transfer/cut.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "geom/accel.h"
@@ -31,6 +32,10 @@ typedef struct cand {
 
 static uint64_t cand_key(float err, int32_t node)
 {
+    /* (A bound that is not a number, from light that is not, is opened
+     * like an unbounded one.) */
+    if (err != err)
+        err = INFINITY;
     uint32_t bits = 0;
     if (err > 0)
         memcpy(&bits, &err, sizeof bits);
