@@ -150,6 +150,8 @@ typedef struct zt_render_stats {
     uint64_t cuts_capped;  /* of which reached the cluster limit: the rest
                               of their light is estimated more coarsely
                               (docs/zone-tracer.md) */
+    uint64_t cuts_shared;  /* of which started from a nearby node's cut
+                              (a mesh's vertex nodes in groups) */
     int forest_loaded;     /* zone: the forest came from options.forest_file
                               (phase_one_seconds is then the time to read it) */
     /* zt_render */

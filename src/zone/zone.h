@@ -96,6 +96,7 @@ typedef struct zone_forest {
     uint64_t links;     /* Phase One: clusters and elements the transfer took */
     uint64_t cuts;      /* transfer cuts made (not kept in forest files) */
     uint64_t cuts_capped; /* of which stopped at their size limit */
+    uint64_t cuts_shared; /* of which started from a neighbour's cut */
     double phase_one_seconds;
     uint64_t rays;
     int loaded;         /* read from a forest file (forest_io.c), not built */

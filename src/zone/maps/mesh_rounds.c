@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "scene/mesh.h"
+#include "zone/maps/mesh_sheet.h"
 #include "util/vec3.h"
 
 #define PI 3.14159265358979323846
@@ -68,96 +69,20 @@ static void tangents(const float *n, double t[3], double b[3])
     b[0] = bb.x, b[1] = bb.y, b[2] = bb.z;
 }
 
-/* A mesh's vertices' neighbours along its edges. */
-typedef struct adjacency {
-    int32_t *first;     /* vertex_count + 1 */
-    int32_t *list;
-} adjacency;
-
-static int adjacency_build(adjacency *a, const mesh *m)
-{
-    int vc = m->vertex_count;
-    a->first = calloc((size_t)vc + 2, sizeof *a->first);
-    a->list = malloc(((size_t)m->triangle_count * 6 + 1) * sizeof *a->list);
-    if (!a->first || !a->list)
-        return 0;
-    for (int t = 0; t < m->triangle_count; t++)
-        for (int e = 0; e < 3; e++)
-            a->first[m->index[3 * t + e] + 1] += 2;
-    for (int v = 0; v < vc; v++)
-        a->first[v + 1] += a->first[v];
-    int32_t *fill = malloc(((size_t)vc + 1) * sizeof *fill);
-    if (!fill)
-        return 0;
-    memcpy(fill, a->first, (size_t)vc * sizeof *fill);
-    for (int t = 0; t < m->triangle_count; t++)
-        for (int e = 0; e < 3; e++) {
-            uint32_t v = m->index[3 * t + e];
-            a->list[fill[v]++] = (int32_t)m->index[3 * t + (e + 1) % 3];
-            a->list[fill[v]++] = (int32_t)m->index[3 * t + (e + 2) % 3];
-        }
-    free(fill);
-    return 1;
-}
-
-static void adjacency_free(adjacency *a)
-{
-    free(a->first);
-    free(a->list);
-}
-
-/* Per thread: the search's marks and queue. */
-typedef struct walk {
-    int32_t *stamp, *queue;
-    int32_t id;
-} walk;
-
-/* The vertices reached from v along the mesh's edges through vertices
- * within `reach` of v facing its way (normals within acos(SAME_NORMAL)):
- * v's own sheet of surface, which a crease or the gap between two fins
- * ends.  They are left in w->queue[1 ..], v first; returns their count
- * with v, or -1 as soon as it meets a vertex that `taken` marks (not 0xff;
- * NULL: none). */
-static int walk_sheet(const adjacency *adj, const float *pos, const float *nrm, int32_t v,
-                      double reach, const uint8_t *taken, walk *w)
-{
-    const float *p = pos + 3 * (size_t)v, *n = nrm + 3 * (size_t)v;
-    int head = 0, tail = 0;
-    w->id++;
-    w->stamp[v] = w->id;
-    w->queue[tail++] = v;
-    while (head < tail) {
-        int32_t u = w->queue[head++];
-        for (int32_t i = adj->first[u]; i < adj->first[u + 1]; i++) {
-            int32_t x = adj->list[i];
-            if (w->stamp[x] == w->id)
-                continue;
-            w->stamp[x] = w->id;
-            if (dist2(pos + 3 * (size_t)x, p) > reach * reach ||
-                dotf(n, nrm + 3 * (size_t)x) < SAME_NORMAL)
-                continue;
-            if (taken && taken[x] != 0xff)
-                return -1;
-            w->queue[tail++] = x;
-        }
-    }
-    return tail;
-}
-
 /* Vertex v's supports: vertices of rounds before r on its sheet within
  * `reach`, near its tangent plane, the nearest in each of SECTORS
  * directions around v, written to out.  Returns how many, 0 when they do
  * not surround v. */
-static int find_supports(const adjacency *adj, const float *pos, const float *nrm,
+static int find_supports(const mesh_adjacency *adj, const float *pos, const float *nrm,
                          const uint8_t *live, const uint8_t *assigned, int32_t base, int32_t v,
-                         int r, double reach, walk *w, int32_t *out)
+                         int r, double reach, sheet_walk *w, int32_t *out)
 {
     const float *p = pos + 3 * (size_t)v, *n = nrm + 3 * (size_t)v;
     double t[3], b[3];
     tangents(n, t, b);
     cand c[SECTORS];
     int filled[SECTORS] = {0};
-    int reached = walk_sheet(adj, pos, nrm, v, reach, NULL, w);
+    int reached = mesh_sheet_walk(adj, pos, nrm, v, reach, SAME_NORMAL, NULL, w);
     for (int j = 1; j < reached; j++) {
         int32_t x = w->queue[j];
         const float *q = pos + 3 * (size_t)x, *m = nrm + 3 * (size_t)x;
@@ -196,10 +121,10 @@ static int find_supports(const adjacency *adj, const float *pos, const float *nr
 }
 
 /* Whether a vertex already taken lies within r of v on its sheet. */
-static int crowded(const adjacency *adj, const float *pos, const float *nrm,
-                   const uint8_t *assigned, int32_t v, double r, walk *w)
+static int crowded(const mesh_adjacency *adj, const float *pos, const float *nrm,
+                   const uint8_t *assigned, int32_t v, double r, sheet_walk *w)
 {
-    return walk_sheet(adj, pos, nrm, v, r, assigned, w) < 0;
+    return mesh_sheet_walk(adj, pos, nrm, v, r, SAME_NORMAL, assigned, w) < 0;
 }
 
 /* One side of one mesh: nodes base .. base + count - 1. */
@@ -214,18 +139,17 @@ static int build_side(mesh_rounds *mr, const surface_nodes *sn, const mesh *m, i
         return 0;
     memset(assigned, 0xff, (size_t)count + 1);
     /* The spread, round by round, in vertex order (a fixed choice). */
-    adjacency adj;
-    walk w0 = {calloc((size_t)count + 1, sizeof(int32_t)),
-               malloc(((size_t)count + 1) * sizeof(int32_t)), 0};
-    int ok = adjacency_build(&adj, m) && w0.stamp && w0.queue;
+    mesh_adjacency adj;
+    sheet_walk w0;
+    int ok = mesh_adjacency_build(&adj, m);
+    ok = sheet_walk_init(&w0, count) && ok;
     double spacing = FIRST_SPACING * sn->h;
     for (int r = 0; r < ROUNDS - 1 && ok; r++, spacing *= 0.5)
         for (int32_t v = 0; v < count; v++)
             if (assigned[v] == 0xff && sn->live[base + v] &&
                 !crowded(&adj, pos, nrm, assigned, v, spacing, &w0))
                 assigned[v] = (uint8_t)r;
-    free(w0.stamp);
-    free(w0.queue);
+    sheet_walk_free(&w0);
     for (int32_t v = 0; v < count; v++)
         if (assigned[v] == 0xff && sn->live[base + v])
             assigned[v] = ROUNDS - 1;
@@ -235,9 +159,8 @@ static int build_side(mesh_rounds *mr, const surface_nodes *sn, const mesh *m, i
         double reach = REACH * spacing; /* the round before's spacing */
 #pragma omp parallel num_threads(threads)
         {
-            walk w = {calloc((size_t)count + 1, sizeof(int32_t)),
-                      malloc(((size_t)count + 1) * sizeof(int32_t)), 0};
-            int have = w.stamp && w.queue;
+            sheet_walk w;
+            int have = sheet_walk_init(&w, count);
             if (!have) {
 #pragma omp atomic write
                 ok = 0;
@@ -252,11 +175,10 @@ static int build_side(mesh_rounds *mr, const surface_nodes *sn, const mesh *m, i
                 nslots[base + v] = (uint8_t)k;
                 round[v] = k ? (uint8_t)r : 0;
             }
-            free(w.stamp);
-            free(w.queue);
+            sheet_walk_free(&w);
         }
     }
-    adjacency_free(&adj);
+    mesh_adjacency_free(&adj);
     free(assigned);
     return ok;
 }

@@ -297,7 +297,7 @@ vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n)
         cut_params p = {.eps = t->f->q.eps, .max_cut = 4096, .leaf = light_leaf, .user = &lc};
         cut_stats st = {0};
         vec3 e = cut_gather(&t->f->light_tree, rs, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)),
-                            &p, &st);
+                            &p, &st, NULL);
         t->rays += st.rays;
         return e;
     }

@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "geom/accel.h"
@@ -27,7 +28,8 @@ typedef struct cand {
     float est[3];       /* its estimate, in the total */
     int32_t left;       /* the node's (sender_node): its children or */
     int32_t count;      /* elements, without reading it again */
-    int32_t seen;       /* visibility taken into est (else unoccluded) */
+    float seen;         /* the share seen, taken into est; -1 before see(),
+                           -2 when it had nothing to see */
 } cand;
 
 static uint64_t cand_key(float err, int32_t node)
@@ -168,7 +170,7 @@ static float estimate(gather *g, int32_t ni, cand *out)
     out->left = node->left;
     out->count = node->count;
     out->est[0] = out->est[1] = out->est[2] = 0;
-    out->seen = 0;
+    out->seen = -1;
     if (!(l->power > 0.0f))
         return 0;
     /* Single precision throughout: bounds and estimates, not sums. */
@@ -252,12 +254,13 @@ static void evaluate(gather *g, int32_t ni, cand *out)
 /* Visibility into a candidate's estimate (rays), once. */
 static void see(gather *g, cand *c, double total[3])
 {
-    if (c->seen)
+    if (c->seen != -1)
         return;
-    c->seen = 1;
+    c->seen = -2;
     if (!(lumf(c->est) > 0))
         return;
     double s = seen_share(g, &g->t->nodes[cand_node(c)]);
+    c->seen = (float)s;
     for (int ch = 0; ch < 3; ch++) {
         float e = (float)(c->est[ch] * s);
         total[ch] += (double)e - c->est[ch];
@@ -285,18 +288,17 @@ static void heap_push(cand *h, int *n, cand c)
     h[i] = c;
 }
 
-static cand heap_pop(cand *h, int *n)
+/* Puts `last` at i or below, the subtrees below i being heaps. */
+static void heap_sift(cand *h, int n, int i, cand last)
 {
-    cand top = h[0], last = h[--*n];
-    int i = 0;
     for (;;) {
         int l = 2 * i + 1, r = l + 1, m = i;
         const cand *best = &last;
-        if (l < *n && above(&h[l], best)) {
+        if (l < n && above(&h[l], best)) {
             m = l;
             best = &h[l];
         }
-        if (r < *n && above(&h[r], best))
+        if (r < n && above(&h[r], best))
             m = r;
         if (m == i)
             break;
@@ -304,40 +306,79 @@ static cand heap_pop(cand *h, int *n)
         i = m;
     }
     h[i] = last;
+}
+
+static cand heap_pop(cand *h, int *n)
+{
+    cand top = h[0], last = h[--*n];
+    heap_sift(h, *n, 0, last);
     return top;
 }
 
-vec3 cut_gather(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo,
-                const cut_params *c, cut_stats *st)
+/* What a cut leaves for a nearby receiver (cut_record). */
+static void record(cut_record *rec, int32_t node, float seen)
 {
-    if (t->node_count == 0 || !(t->total_power > 0))
-        return v3(0, 0, 0);
-    gather g = {t, rs, v3_to_f3(x), v3_to_f3(n), xo, st};
+    if (!rec || rec->failed)
+        return;
+    if (rec->n == rec->cap) {
+        int cap = rec->cap ? 2 * rec->cap : 1024;
+        cut_entry *e = realloc(rec->e, (size_t)cap * sizeof *e);
+        if (!e) {
+            rec->failed = 1;
+            return;
+        }
+        rec->e = e;
+        rec->cap = cap;
+    }
+    rec->e[rec->n++] = (cut_entry){node, seen};
+}
+
+/* A cut's state: the clusters in it, in a heap by bound; the sum of their
+ * estimates and of the elements taken exactly. */
+typedef struct cut_state {
     cand heap[HEAP_MAX];
-    int hn = 0, cut = 0;
-    double total[3] = {0, 0, 0}, exact[3] = {0, 0, 0};
-    cand root;
-    evaluate(&g, 0, &root);
-    for (int ch = 0; ch < 3; ch++)
-        total[ch] = root.est[ch];
-    if (cand_err(&root) > 0 || lumf(root.est) > 0)
-        heap_push(heap, &hn, root);
+    int hn;
+    double total[3], exact[3];
+} cut_state;
+
+/* A leaf's elements, exactly. */
+static void take_exactly(gather *g, int32_t left, int32_t count, vec3 x, vec3 n,
+                         const cut_params *c, cut_state *s)
+{
+    int first = -1 - left;
+    for (int i = first; i < first + count; i++) {
+        g->st->clusters++;
+        c->leaf(c->user, i, x, n, s->exact, g->st);
+    }
+}
+
+/* Opens the worst cluster while its bound exceeds eps times the total (or
+ * the floor), at most max_cut times; then every cluster left is seen, and
+ * the cut is recorded in rec (if any). */
+static vec3 refine(gather *g, cut_state *s, vec3 x, vec3 n, const cut_params *c,
+                   cut_record *rec)
+{
+    const sender_tree *t = g->t;
+    cut_stats *st = g->st;
+    cand *heap = s->heap;
+    double *total = s->total;
+    int cut = 0;
     /* A cluster's rays are cast only when it may stay in the cut (its
      * bound within the limit when it is made, or at the end): about half
      * the clusters made are opened again, and their rays were wasted. */
-    while (hn > 0) {
-        double limit = c->eps * dmax(lum(total) + lum(exact), c->floor);
+    while (s->hn > 0) {
+        double limit = c->eps * dmax(lum(total) + lum(s->exact), c->floor);
         if (cand_err(&heap[0]) <= limit)
             break;
         if (cut >= c->max_cut && cand_err(&heap[0]) < INFINITY) {
             st->capped++;
             break;
         }
-        cand top = heap_pop(heap, &hn);
+        cand top = heap_pop(heap, &s->hn);
         /* The next clusters to open are near the heap's top: their
          * children's records, from anywhere in the tree, are fetched while
          * this one's are weighed. */
-        for (int h = 0; h < 3 && h < hn; h++)
+        for (int h = 0; h < 3 && h < s->hn; h++)
             if (heap[h].count == 0) {
                 __builtin_prefetch(&t->nodes[heap[h].left]);
                 __builtin_prefetch(&t->nodes[heap[h].left + 1]);
@@ -347,30 +388,94 @@ vec3 cut_gather(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo
         for (int ch = 0; ch < 3; ch++)
             total[ch] -= top.est[ch];
         if (top.count > 0) {
-            int first = -1 - top.left;
-            for (int i = first; i < first + top.count; i++) {
-                st->clusters++;
-                c->leaf(c->user, i, x, n, exact, st);
-            }
+            take_exactly(g, top.left, top.count, x, n, c, s);
+            record(rec, cand_node(&top), CUT_EXACT);
             continue;
         }
         cut++;
         for (int k = 0; k < 2; k++) {
             cand ch;
-            evaluate(&g, top.left + k, &ch);
+            evaluate(g, top.left + k, &ch);
             if (!(cand_err(&ch) > 0) && !(lumf(ch.est) > 0))
                 continue;
             for (int q = 0; q < 3; q++)
                 total[q] += ch.est[q];
-            if (cand_err(&ch) <= limit || hn >= HEAP_MAX)
-                see(&g, &ch, total);
-            if (hn >= HEAP_MAX)
-                continue; /* no room: it stays as estimated (it is in) */
-            heap_push(heap, &hn, ch);
+            if (cand_err(&ch) <= limit || s->hn >= HEAP_MAX)
+                see(g, &ch, total);
+            if (s->hn >= HEAP_MAX) {
+                /* No room: it stays as estimated (it is in). */
+                record(rec, top.left + k, ch.seen);
+                continue;
+            }
+            heap_push(heap, &s->hn, ch);
         }
     }
-    for (int h = 0; h < hn; h++)
-        see(&g, &heap[h], total);
-    return v3(dmax(0.0, total[0] + exact[0]), dmax(0.0, total[1] + exact[1]),
-              dmax(0.0, total[2] + exact[2]));
+    for (int h = 0; h < s->hn; h++) {
+        see(g, &heap[h], total);
+        record(rec, cand_node(&heap[h]), heap[h].seen);
+    }
+    return v3(dmax(0.0, total[0] + s->exact[0]), dmax(0.0, total[1] + s->exact[1]),
+              dmax(0.0, total[2] + s->exact[2]));
+}
+
+vec3 cut_gather(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo,
+                const cut_params *c, cut_stats *st, cut_record *rec)
+{
+    if (rec) {
+        rec->n = 0;
+        rec->failed = 0;
+    }
+    if (t->node_count == 0 || !(t->total_power > 0))
+        return v3(0, 0, 0);
+    gather g = {t, rs, v3_to_f3(x), v3_to_f3(n), xo, st};
+    cut_state s;
+    s.hn = 0;
+    cand root;
+    evaluate(&g, 0, &root);
+    for (int ch = 0; ch < 3; ch++) {
+        s.total[ch] = root.est[ch];
+        s.exact[ch] = 0;
+    }
+    if (cand_err(&root) > 0 || lumf(root.est) > 0)
+        heap_push(s.heap, &s.hn, root);
+    return refine(&g, &s, x, n, c, rec);
+}
+
+vec3 cut_resume(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo,
+                const cut_record *from, const cut_params *c, cut_stats *st)
+{
+    if (t->node_count == 0 || !(t->total_power > 0))
+        return v3(0, 0, 0);
+    gather g = {t, rs, v3_to_f3(x), v3_to_f3(n), xo, st};
+    cut_state s;
+    s.hn = 0;
+    for (int ch = 0; ch < 3; ch++)
+        s.total[ch] = s.exact[ch] = 0;
+    for (int i = 0; i < from->n; i++) {
+        const cut_entry *e = &from->e[i];
+        const sender_node *node = &t->nodes[e->node];
+        if (e->seen == CUT_EXACT) {
+            take_exactly(&g, node->left, node->count, x, n, c, &s);
+            continue;
+        }
+        cand ch;
+        evaluate(&g, e->node, &ch);
+        if (!(cand_err(&ch) > 0) && !(lumf(ch.est) > 0))
+            continue;
+        if (e->seen >= 0) {
+            /* The nearby receiver's rays stand for this one's. */
+            for (int q = 0; q < 3; q++)
+                ch.est[q] *= e->seen;
+            ch.seen = e->seen;
+        }
+        for (int q = 0; q < 3; q++)
+            s.total[q] += ch.est[q];
+        if (s.hn < HEAP_MAX)
+            s.heap[s.hn++] = ch;
+        else
+            see(&g, &ch, s.total);
+    }
+    for (int i = s.hn / 2 - 1; i >= 0; i--)
+        heap_sift(s.heap, s.hn, i, s.heap[i]);
+    return refine(&g, &s, x, n, c, NULL);
 }

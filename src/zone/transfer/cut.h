@@ -32,10 +32,32 @@ typedef struct cut_params {
     void *user;
 } cut_params;
 
+/* A finished cut, for a nearby receiver to start from: its clusters with
+ * the share of each that the receiver's rays saw (-1 or -2: none cast),
+ * and the leaves it took exactly (CUT_EXACT). */
+#define CUT_EXACT -3.0f
+typedef struct cut_entry {
+    int32_t node;
+    float seen;
+} cut_entry;
+
+typedef struct cut_record {
+    cut_entry *e;
+    int n, cap;
+    int failed;         /* out of memory: incomplete, not to be used */
+} cut_record;
+
 /* Irradiance at x (unit normal n, rays leave from xo) from the tree's
- * filled light. */
+ * filled light; the cut is left in rec (NULL: not kept). */
 vec3 cut_gather(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo,
-                const cut_params *p, cut_stats *st);
+                const cut_params *p, cut_stats *st, cut_record *rec);
+
+/* The same at a receiver near the one `from` was made for: its clusters
+ * estimated for this receiver, visible as far as that one saw them (rays
+ * of its own where that one cast none), its exact leaves taken again here;
+ * then refined as cut_gather does, opening at most p->max_cut more. */
+vec3 cut_resume(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo,
+                const cut_record *from, const cut_params *p, cut_stats *st);
 
 /* Whether the straight path from xo to `to` is open (a ray, counted). */
 int cut_visible(const rscene *rs, vec3f xo, vec3 to, int background, cut_stats *st);

@@ -211,10 +211,18 @@ static void leaf(void *user, int i, vec3 x, vec3 n, double acc[3], cut_stats *st
 }
 
 vec3 transfer_irradiance(const transfer_ctx *c, vec3 x, vec3 n, int receiver,
-                         transfer_stats *st)
+                         transfer_stats *st, cut_record *rec)
 {
     (void)receiver;
     cut_params p = {.eps = c->eps, .floor = c->floor, .max_cut = c->max_cut,
                     .leaf = leaf, .user = (void *)c};
-    return cut_gather(c->tree, c->rs, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)), &p, st);
+    return cut_gather(c->tree, c->rs, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)), &p, st, rec);
+}
+
+vec3 transfer_irradiance_near(const transfer_ctx *c, vec3 x, vec3 n, const cut_record *from,
+                              int more, transfer_stats *st)
+{
+    cut_params p = {.eps = c->eps, .floor = c->floor, .max_cut = more,
+                    .leaf = leaf, .user = (void *)c};
+    return cut_resume(c->tree, c->rs, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)), from, &p, st);
 }

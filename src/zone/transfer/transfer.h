@@ -29,8 +29,13 @@ typedef struct transfer_ctx {
 typedef cut_stats transfer_stats;
 
 /* Irradiance at x (unit normal n) from the tree's light.  receiver is the
- * primitive x lies on (-1: none). */
+ * primitive x lies on (-1: none).  The cut is kept in rec (NULL: not). */
 vec3 transfer_irradiance(const transfer_ctx *c, vec3 x, vec3 n, int receiver,
-                         transfer_stats *st);
+                         transfer_stats *st, cut_record *rec);
+
+/* The same at a receiver near the one whose cut `from` is, starting from
+ * that cut and opening at most `more` clusters of its own (cut_resume). */
+vec3 transfer_irradiance_near(const transfer_ctx *c, vec3 x, vec3 n, const cut_record *from,
+                              int more, transfer_stats *st);
 
 #endif
