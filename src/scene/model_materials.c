@@ -9,6 +9,7 @@
 #include "scene/model_materials.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -129,6 +130,18 @@ static int copy_texels(const struct aiTexture *t, mesh_texture *out, char *why, 
 /* Decodes the texture the material names ("*N" for the file's embedded
  * texture N, else a file name relative to the model).  Returns 1, or 0 with
  * the reason. */
+/* printf into a buffer, cut to its size: the names and reasons a model
+ * file supplies may be longer than a message needs. */
+static void clip_text(char *to, size_t n, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static void clip_text(char *to, size_t n, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(to, n, fmt, ap);
+    va_end(ap);
+}
+
 static int load_texture(const struct aiScene *sc, const char *folder, const char *name,
                         mesh_texture *out, char *why, size_t n)
 {
@@ -137,14 +150,14 @@ static int load_texture(const struct aiScene *sc, const char *folder, const char
         char *end;
         long k = strtol(name + 1, &end, 10);
         if (*end || k < 0 || (unsigned long)k >= sc->mNumTextures || !sc->mTextures[k]) {
-            snprintf(why, n, "names embedded texture %s, which the file does not have", name);
+            clip_text(why, n, "names embedded texture %s, which the file does not have", name);
             return 0;
         }
         const struct aiTexture *t = sc->mTextures[k];
         if (t->mHeight != 0)
             return copy_texels(t, out, why, n);
         if (!t->pcData) {
-            snprintf(why, n, "embedded texture %s is empty", name);
+            clip_text(why, n, "embedded texture %s is empty", name);
             return 0;
         }
         return texture_decode((const unsigned char *)t->pcData, t->mWidth, out, why, n);
@@ -165,13 +178,13 @@ static int load_texture(const struct aiScene *sc, const char *folder, const char
     char reason[128];
     unsigned char *data = read_whole(file, &size, reason, sizeof reason);
     if (!data) {
-        snprintf(why, n, "%s %s", file, reason);
+        clip_text(why, n, "%s %s", file, reason);
         return 0;
     }
     int ok = texture_decode(data, size, out, reason, sizeof reason);
     free(data);
     if (!ok)
-        snprintf(why, n, "%s: %s", file, reason);
+        clip_text(why, n, "%s: %s", file, reason);
     return ok;
 }
 
@@ -209,7 +222,7 @@ static int material_texture(const struct aiScene *sc, const struct aiMaterial *a
         tex.wrap = mode[0] != aiTextureMapMode_Clamp && mode[0] != aiTextureMapMode_Decal;
         int k = m->texture_count++;
         m->textures[k] = tex;
-        snprintf(names[k], sizeof names[k], "%s", name.data);
+        clip_text(names[k], sizeof names[k], "%s", name.data);
         return k;
     }
     return -1;
@@ -221,7 +234,7 @@ static void map_material(const struct aiMaterial *am, int gltf, mesh_slot *s)
     memset(s, 0, sizeof *s);
     struct aiString name;
     if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS)
-        snprintf(s->name, sizeof s->name, "%s", name.data);
+        clip_text(s->name, sizeof s->name, "%s", name.data);
     vec3 color = v3(0.8, 0.8, 0.8); /* a material without colour: light grey */
     if (!get_color(am, AI_MATKEY_BASE_COLOR, &color))
         get_color(am, AI_MATKEY_COLOR_DIFFUSE, &color);
