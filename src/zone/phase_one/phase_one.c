@@ -75,16 +75,16 @@ static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
  * (Lightcuts' bounds carry no visibility), and the groups pay for it.
  * The engine room at depth 3, 512 x 512 (whole job, error per pixel / over
  * 4 x 4 blocks; single runs one after the other): without groups 54.5 s,
- * 1.68% / 1.01%, and with the mesh's limit x 1.5 76.7 s, 1.64% / 0.96%;
- * groups within h/16, h/8, h/4 (limit x 1) 42.1, 38.4, 35.0 s for 1.70% /
- * 1.03%, 1.72% / 1.05%, 1.98% / 1.24%; h/8 with the limit x 1.5 48.1 s,
- * 1.68% / 0.997%, x 2 61.0 s, 1.67% / 0.98%.  Members opening none of
- * their own (h/8, x 1): 32.7 s, 1.76% / 1.07%. */
+ * 1.68% / 1.014%, and with the mesh's limit x 1.5 76.7 s, 1.64% / 0.96%;
+ * with groups, the mesh's limit x 1 38.4 s, 1.72% / 1.041%; x 1.25 45.7 s,
+ * 1.69% / 0.994%; x 1.5 54.1 s, 1.68% / 0.994%.  Groups by distance
+ * alone (no sheet walk, x 1) within h/16 and h/4: 1.70% / 1.03% and
+ * 1.98% / 1.24%. */
 #define GROUP_RADIUS (1.0 / 8)
 #define GROUP_NORMAL 0.9
 #define GROUP_MORE 16
-#define MESH_CUT_NUM 3
-#define MESH_CUT_DEN 2
+#define MESH_CUT_NUM 5
+#define MESH_CUT_DEN 4
 
 static vec3 node_point(const surface_nodes *sn, int32_t k, vec3 *n)
 {
