@@ -1,7 +1,8 @@
 /* Rendering across processes (docs/cluster.md): `mpirun -n R zonetrace
  * render` writes the same bytes as one process, for R = 1, 2 and 3, with
  * the path tracer (also resumed at another R), the zone tracer (both
- * strategies, and its forest file) and an animation; a process that fails
+ * strategies, a model whose nodes share cuts, and its forest file) and an
+ * animation; a process that fails
  * ends the job with the message and status one process would give, never a
  * hang.  (A build without MPI skips this; test_cluster_single tests its
  * refusal under mpirun.) */
@@ -53,19 +54,58 @@ static const char *cornell(void)
     return path;
 }
 
-/* One process's output, then R = 1, 2, 3 processes' (name_R.ext), the
- * same bytes. */
-static void same_at_every_count(const char *options, const char *name, const char *ext)
+/* A smooth OBJ sheet of fine squares facing down over a lit floor, a
+ * small triangle far away setting the node spacing: its vertex nodes share
+ * cuts in groups, whose members the process of their leader computes. */
+static const char *sheet_scene(void)
+{
+    static char path[1024];
+    if (path[0])
+        return path;
+    enum { SQUARES = 30 };
+    static char obj[(SQUARES + 1) * (SQUARES + 1) * 40 + SQUARES * SQUARES * 80 + 64];
+    size_t len = (size_t)snprintf(obj, sizeof obj, "vn 0 -1 0\n");
+    for (int i = 0; i <= SQUARES; i++)
+        for (int j = 0; j <= SQUARES; j++)
+            len += (size_t)snprintf(obj + len, sizeof obj - len, "v %g 20 %g\n", 0.5 * j,
+                                    0.5 * i);
+    for (int i = 0; i < SQUARES; i++)
+        for (int j = 0; j < SQUARES; j++) {
+            int a = 1 + i * (SQUARES + 1) + j, b = a + 1, c = a + SQUARES + 1, d = c + 1;
+            len += (size_t)snprintf(obj + len, sizeof obj - len,
+                                    "f %d//1 %d//1 %d//1\nf %d//1 %d//1 %d//1\n", a, b, d, a,
+                                    d, c);
+        }
+    char objpath[1024], text[2048];
+    snprintf(objpath, sizeof objpath, "%s", test_write_file("job_sheet.obj", obj));
+    snprintf(text, sizeof text,
+             "{\"camera\": {\"position\": [8, 5, -40], \"lookat\": [8, 12, 8], "
+             "\"up\": [0, 1, 0], \"fov\": 50, \"gridresolution\": [8, 8]}, \"scene\": ["
+             "{\"light\": {\"emission\": [40, 40, 40], \"backculled\": false, \"parts\": ["
+             "{\"lighttriangle\": {\"points\": [[25, 10, 0], [35, 10, 15], [35, 10, 0]]}}]}},"
+             "{\"plane\": {\"normal\": [0, 1, 0], \"offset\": 0, " TEST_DIFFUSE(0.7) "}},"
+             "{\"thing\": {" TEST_DIFFUSE(0.5) ", \"parts\": [{\"triangle\": {\"points\": "
+             "[[400, 0, 400], [401, 0, 400], [400, 1, 400]]}}]}},"
+             "{\"mesh\": {\"file\": \"%s\", \"smooth\": true, \"backculled\": true, "
+             TEST_DIFFUSE(0.5) "}}]}",
+             objpath);
+    snprintf(path, sizeof path, "%s", test_write_file("job_sheet.json", text));
+    return path;
+}
+
+/* One process's output of `scene`, then R = 1, 2, 3 processes'
+ * (name_R.ext), the same bytes. */
+static void same_at_every_count_of(const char *scene, const char *options, const char *name,
+                                   const char *ext)
 {
     char args[4096], one[256];
     snprintf(one, sizeof one, "%s_single.%s", name, ext);
-    snprintf(args, sizeof args, "render '%s' %s -q -o '%s'", cornell(), options,
-             test_tmp_path(one));
+    snprintf(args, sizeof args, "render '%s' %s -q -o '%s'", scene, options, test_tmp_path(one));
     assert_int_equal(test_run_cli(args, NULL), 0);
     for (int ranks = 1; ranks <= 3; ranks++) {
         char mine[256], *err = NULL;
         snprintf(mine, sizeof mine, "%s_%d.%s", name, ranks, ext);
-        snprintf(args, sizeof args, "render '%s' %s --threads 1 -q -o '%s'", cornell(), options,
+        snprintf(args, sizeof args, "render '%s' %s --threads 1 -q -o '%s'", scene, options,
                  test_tmp_path(mine));
         int rc = run_job(ranks, args, &err);
         if (rc != 0)
@@ -75,6 +115,11 @@ static void same_at_every_count(const char *options, const char *name, const cha
         snprintf(a, sizeof a, "%s", test_tmp_path(one));
         test_assert_same_file(a, test_tmp_path(mine));
     }
+}
+
+static void same_at_every_count(const char *options, const char *name, const char *ext)
+{
+    same_at_every_count_of(cornell(), options, name, ext);
 }
 
 static void test_path_tracer(void **state)
@@ -112,6 +157,27 @@ static void test_zone_tracer(void **state)
     same_at_every_count("--method zone --quality 0 --size 40x30", "zone_pixel", "pfm");
     same_at_every_count("--method zone --quality 0 --strategy zone --size 40x30", "zone_zone",
                         "pfm");
+}
+
+/* A model whose vertex nodes share cuts: each member is computed by the
+ * process of its leader, wherever its own block falls. */
+static void test_zone_groups(void **state)
+{
+    (void)state;
+    char args[4096], *err = NULL;
+    snprintf(args, sizeof args, "render '%s' --method zone --size 24x16 -v -o '%s'",
+             sheet_scene(), test_tmp_path("groups_v.pfm"));
+    assert_int_equal(test_run_cli(args, &err), 0);
+    const char *at = err ? strstr(err, " started from a neighbour's") : NULL;
+    if (!at) {
+        size_t n = err ? strlen(err) : 0;
+        fail_msg("-v reports no shared cuts; it ends: %s", err ? err + (n > 600 ? n - 600 : 0) : "");
+    }
+    while (at > err && at[-1] != ' ')
+        at--;
+    assert_true(atol(at) > 100);
+    free(err);
+    same_at_every_count_of(sheet_scene(), "--method zone --size 24x16", "zone_groups", "pfm");
 }
 
 /* The forest Phase One builds split over processes is the one a single
@@ -258,6 +324,7 @@ int main(void)
         cmocka_unit_test(test_path_tracer),
         cmocka_unit_test(test_path_resumed),
         cmocka_unit_test(test_zone_tracer),
+        cmocka_unit_test(test_zone_groups),
         cmocka_unit_test(test_zone_forest),
         cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_animation),

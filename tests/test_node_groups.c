@@ -5,8 +5,9 @@
  * sets the node spacing (the scene's size / 40) well above the sheets'
  * vertex spacing.  Checked: the groups' rules (near the leader, on its
  * sheet, facing its way, never across the two stacked sheets), that every
- * node left alone has no free neighbour, and that a member's cut started
- * from its leader's gives what its own cut gives, within stated bounds.
+ * node left alone has no free neighbour, that a member's cut started
+ * from its leader's gives what its own cut gives, within stated bounds,
+ * and that the forest is the same on any thread count.
  *
  * Needs nothing from ../shared. */
 #include "test_support.h"
@@ -63,7 +64,7 @@ static const char *write_sheets(void)
     return path;
 }
 
-static zt_renderer *render_sheets(zt_scene **scene_out)
+static zt_renderer *render_sheets_on(int threads, zt_scene **scene_out)
 {
     char text[2048];
     snprintf(text, sizeof text,
@@ -78,9 +79,14 @@ static zt_renderer *render_sheets(zt_scene **scene_out)
                  0.5) "}}]}",
              write_sheets());
     zt_scene *scene = test_scene_text(text, "group_sheets.json");
-    zt_renderer *r = test_zone_renderer(scene, 2, 2, zt_render_options_default().quality);
+    zt_renderer *r = test_zone_renderer(scene, 2, threads, zt_render_options_default().quality);
     *scene_out = scene;
     return r;
+}
+
+static zt_renderer *render_sheets(zt_scene **scene_out)
+{
+    return render_sheets_on(2, scene_out);
 }
 
 static double dist(const surface_nodes *sn, int32_t a, int32_t b)
@@ -231,11 +237,32 @@ static void test_members_start_from_the_leaders_cut(void **state)
     zt_scene_release(scene);
 }
 
+/* Members are computed by their leader's thread, in its pass: the forest
+ * is the same on one thread as on three. */
+static void test_forest_the_same_on_any_thread_count(void **state)
+{
+    (void)state;
+    zt_scene *s1, *s3;
+    zt_renderer *r1 = render_sheets_on(1, &s1), *r3 = render_sheets_on(3, &s3);
+    const zone_forest *a = r1->forest, *b = r3->forest;
+    assert_true(a->cuts_shared > 0);
+    assert_int_equal(a->cuts_shared, b->cuts_shared);
+    assert_int_equal(a->sn.node_count, b->sn.node_count);
+    assert_int_equal(a->map_levels, b->map_levels);
+    size_t n = (size_t)a->map_levels * (size_t)a->sn.node_count * 3;
+    assert_memory_equal(a->e, b->e, n * sizeof *a->e);
+    zt_renderer_release(r1);
+    zt_renderer_release(r3);
+    zt_scene_release(s1);
+    zt_scene_release(s3);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_groups_follow_their_rules),
         cmocka_unit_test(test_members_start_from_the_leaders_cut),
+        cmocka_unit_test(test_forest_the_same_on_any_thread_count),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
