@@ -44,7 +44,9 @@ typedef struct cut_entry {
 typedef struct cut_record {
     cut_entry *e;
     int n, cap;
-    int failed;         /* out of memory: incomplete, not to be used */
+    int failed;         /* not to be used: incomplete (out of memory), or
+                           its owner's cut not made yet; cut_gather clears
+                           it */
 } cut_record;
 
 /* Irradiance at x (unit normal n, rays leave from xo) from the tree's
