@@ -137,6 +137,9 @@ typedef struct zone_trace {
     const zone_forest *f;
     const zt_renderer *r;
     uint64_t rays;
+    /* Exact direct light at a camera sample that shares the fallback's
+     * rays with its neighbours (direct_irradiance_split), 0: alone. */
+    int light_split;
 } zone_trace;
 
 /* Irradiance of level `level` at point x (normal n) on side `side` of

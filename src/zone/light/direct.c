@@ -319,17 +319,12 @@ static vec3 lift(const light_frame *f, double a, double b)
     return v3_add(f->origin, v3_add(v3_scale(f->u, a), v3_scale(f->v, b)));
 }
 
-/* Cuts the shadows of every primitive but the receiver and the light out
- * of the pieces.  Returns 1 when done, 0 when x is enclosed and sees
- * nothing, -1 when more occluders stand in the way than clipping takes
- * (the caller then sees the light by rays). */
-static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, vec3 x,
-                         vec3 n, int receiver, poly2_set *set, poly2 *scratch)
+/* Where a shadow of the light at x can come from: the box around x and
+ * the light's pieces, cut by the pyramid from x through the light (fr, its
+ * side planes, also returned). */
+static void shadow_region(const zprim *light, const light_frame *f, vec3 x, const poly2_set *set,
+                          occ_region *out, frustum *out_fr)
 {
-    const zt_scene *sc = c->scene;
-    zprim lpp;
-    zprim_get(sc, c->rs, light, &lpp);
-    /* Only what meets the box around x and the light can cast a shadow. */
     occ_region region;
     region.lo = x;
     region.hi = x;
@@ -345,7 +340,7 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
      * too, which the pyramid does not bound, so they skip the test. */
     frustum fr = {0, {{0, 0, 0}}};
     const poly2 *lp = &set->piece[0];
-    if (set->count == 1 && lp->n >= 3 && lp->n <= FRUSTUM_MAX && !lpp.background) {
+    if (set->count == 1 && lp->n >= 3 && lp->n <= FRUSTUM_MAX && !light->background) {
         vec3 q0 = lift(f, lp->x[lp->n - 1], lp->y[lp->n - 1]), inside = v3(0, 0, 0);
         for (int i = 0; i < lp->n; i++)
             inside = v3_add(inside, lift(f, lp->x[i], lp->y[i]));
@@ -363,11 +358,28 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
             q0 = q1;
         }
     }
-    if (lpp.background) {
+    if (light->background) {
         /* Foreground primitives beyond the light hide it too. */
         region.lo = v3(-INFINITY, -INFINITY, -INFINITY);
         region.hi = v3(INFINITY, INFINITY, INFINITY);
     }
+    *out = region;
+    *out_fr = fr;
+}
+
+/* Cuts the shadows of every primitive but the receiver and the light out
+ * of the pieces.  Returns 1 when done, 0 when x is enclosed and sees
+ * nothing, -1 when more occluders stand in the way than clipping takes
+ * (the caller then sees the light by rays). */
+static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, vec3 x,
+                         vec3 n, int receiver, poly2_set *set, poly2 *scratch)
+{
+    const zt_scene *sc = c->scene;
+    zprim lpp;
+    zprim_get(sc, c->rs, light, &lpp);
+    occ_region region;
+    frustum fr;
+    shadow_region(&lpp, f, x, set, &region, &fr);
     /* Infinite planes are few and in no index. */
     for (int i = 0; i < sc->part_count; i++)
         if (i != receiver && i != light && sc->parts[i].shape == SHAPE_PLANE &&
@@ -386,14 +398,22 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
 
 /* The irradiance of polygon piece p (on the light's plane) at x, with
  * visibility by rays: p is cut into triangles of about 1/count of the
- * light each, and each counts if a ray from x reaches its centre. */
+ * light each, and each counts if a ray from x reaches its centre.  With
+ * split s in 1..4 the triangles are four times as large and the ray goes to
+ * the centre of their quarter s (corner s, or the middle for 4): four
+ * points with splits 1..4 side by side see, between them, the centres of the
+ * finer triangles. */
 static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p, vec3 x, vec3 n,
-                      int background, int count)
+                      int background, int count, int split)
 {
     /* Fan triangles, each cut into 4^k by midpoints. */
     int fan = p->n - 2, k = 0;
     while (fan * (1 << (2 * k)) < count && k < 6)
         k++;
+    if (k == 0)
+        split = 0;
+    if (split)
+        k--;
     int m = 1 << k;
     vec3f xo = ray_offset(v3_to_f3(x), v3_to_f3(n));
     double e = 0;
@@ -421,6 +441,10 @@ static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p,
                     if (!(g > 0))
                         continue;
                     vec3 ctr = v3_scale(v3_add(v3_add(q[0], q[1]), q[2]), 1.0 / 3.0);
+                    if (split >= 1 && split <= 3)
+                        /* (4 q_s + the other two) / 6: the centre of the
+                         * quarter at corner s. */
+                        ctr = v3_add(v3_scale(ctr, 0.5), v3_scale(q[split - 1], 0.5));
                     vec3f to = f3_sub(v3_to_f3(ctr), xo);
                     float dist = f3_length(to);
                     if (!(dist > 0.0f))
@@ -435,6 +459,12 @@ static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p,
 
 double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
                          int receiver)
+{
+    return direct_irradiance_split(c, light, x, n, receiver, 0);
+}
+
+double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
+                               int split)
 {
     zprim lpp;
     zprim_get(c->scene, c->rs, light, &lpp);
@@ -467,7 +497,7 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
     poly2 whole = pieces[0];
     int cut = cut_occluders(c, light, &f, x, n, receiver, &set, &scratch);
     if (cut < 0)
-        return by_rays(c, &f, &whole, x, n, lp->background, c->fallback);
+        return by_rays(c, &f, &whole, x, n, lp->background, c->fallback, split);
     if (cut == 0)
         return 0;
     double e = 0;
@@ -484,6 +514,25 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
 }
 
 /* Where the line from a through b meets the plane (pn, po). */
+int direct_by_rays(const direct_ctx *c, int light, vec3 x, vec3 n)
+{
+    zprim lpp;
+    zprim_get(c->scene, c->rs, light, &lpp);
+    light_frame f;
+    poly2 pieces[1];
+    poly2_set set = {pieces, 1, 1, 0};
+    if (!light_polygon(c, light, x, &f, &pieces[0]))
+        return 0;
+    poly2_clip(&pieces[0], v3_dot(n, f.u), v3_dot(n, f.v), v3_dot(n, v3_sub(f.origin, x)));
+    if (pieces[0].n < 3)
+        return 0;
+    occ_region region;
+    frustum fr;
+    shadow_region(&lpp, &f, x, &set, &region, &fr);
+    int32_t cand[DIRECT_MAX_OCCLUDERS];
+    return occluders_query(c->occ, &region, cand, DIRECT_MAX_OCCLUDERS) > DIRECT_MAX_OCCLUDERS;
+}
+
 static vec3 through_plane(vec3 a, vec3 b, vec3 pn, double po)
 {
     vec3 d = v3_sub(b, a);

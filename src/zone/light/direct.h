@@ -32,6 +32,20 @@ typedef struct direct_ctx {
 double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
                          int receiver);
 
+/* The same for one of four points side by side (split 1..4; 0 is the call
+ * above) that share the fallback's rays: where the light is seen by rays,
+ * each point takes a quarter of the pieces' centres, so the four together
+ * cost one point's rays and see as many directions.  Exact cuts are
+ * unchanged. */
+#define DIRECT_SPLITS 4
+
+/* Whether direct_irradiance sees light part `light` from x by rays (too
+ * many occluders to clip): where a shadow is that busy, it may change
+ * within a pixel. */
+int direct_by_rays(const direct_ctx *c, int light, vec3 x, vec3 n);
+double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
+                               int split);
+
 /* The fraction of a pixel (corners on the screen, in order around it) in
  * which the eye sees light part `light` directly, with exact occlusion:
  * the pixel's footprint on the light's plane, cut like a shadow, measured

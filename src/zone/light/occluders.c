@@ -175,9 +175,11 @@ int occluders_query(const occluder_index *ix, const occ_region *r, int32_t *out,
         if (node->count > 0) {
             int first = -1 - node->left;
             for (int i = 0; i < node->count; i++) {
-                if (found < max)
-                    out[found] = ix->prims[first + i];
-                found++;
+                /* Past max the caller needs only to know that: a point
+                 * under a whole mesh would walk most of the index. */
+                if (found == max)
+                    return max + 1;
+                out[found++] = ix->prims[first + i];
             }
         } else {
             stack[sp++] = node->left + 1;

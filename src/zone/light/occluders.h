@@ -47,7 +47,8 @@ typedef struct occ_region {
 
 /* Writes into out (room for max) the primitives whose boxes meet the
  * region (conservatively: some may not), in ascending order; returns how
- * many there are, which may exceed max (then only max were written). */
+ * many there are, or max + 1 when there are more than max (the search then
+ * stops, and what out holds is no particular subset). */
 int occluders_query(const occluder_index *ix, const occ_region *r, int32_t *out, int max);
 
 #endif

@@ -284,7 +284,8 @@ static void light_leaf(void *user, int i, vec3 x, vec3 n, double acc[3], cut_sta
                          el->n[2] * (x.z - el->c[2])) <= 0)
         return;
     const float *em = &f->light_tree.elem_radiance[3 * (size_t)i];
-    double g = direct_irradiance(&f->direct, el->prim, x, n, lc->receiver);
+    double g = direct_irradiance_split(&f->direct, el->prim, x, n, lc->receiver,
+                                       lc->t->light_split);
     for (int ch = 0; ch < 3; ch++)
         acc[ch] += g * em[ch];
 }
@@ -309,7 +310,7 @@ vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n)
         vec3f em = rs->objects[lp->object].emission;
         if (f3_is_black(em))
             continue;
-        double g = direct_irradiance(&t->f->direct, prim, x, n, receiver);
+        double g = direct_irradiance_split(&t->f->direct, prim, x, n, receiver, t->light_split);
         e = v3_add(e, v3_scale(f3_to_v3(em), g));
     }
     return e;

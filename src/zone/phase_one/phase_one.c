@@ -100,7 +100,7 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
                        uint64_t *links, uint64_t *capped)
 {
     const surface_nodes *sn = &f->sn;
-    zone_trace t = {f, r, 0};
+    zone_trace t = {f, r, 0, 0};
     vec3 n, x = node_point(sn, k, &n);
     int prim = sn->prim_of[k];
     vec3 e;

@@ -1,7 +1,9 @@
 /* Phase Two, step one: the sample list of every pixel.
  *
  * A pixel whose corner and sub-pixel signatures agree sees one smooth
- * surface: its g x g samples are shaded, each with weight 1/g^2.  Where they
+ * surface: its g x g samples are shaded, each with weight 1/g^2 (a mesh's
+ * detail takes 8 x 8, and at g = 1 a busy shadow 2 x 2, each 2 x 2 block
+ * sharing one point's rays of direct light).  Where they
  * differ, an edge crosses the pixel: a 16 x 16 grid (32 x 32 at quality 3,
  * 64 x 64 from 4) measures the coverage of each surface (group of equal
  * signatures), and each group is shaded on the samples of a sparse 4 x 4
@@ -22,6 +24,7 @@
 #include "geom/shapes.h"
 #include "render/prim.h"
 #include "util/vec3_convert.h"
+#include "zone/light/direct.h"
 #include "zone/phase_two/media.h"
 #include "zone/phase_two/phase_two.h"
 
@@ -31,10 +34,13 @@
 #define CURVED_GRID 2  /* sub-pixel grid of smooth pixels that see a sphere */
 /* and of those that may hold a mesh's sub-pixel detail (fine_detail): one
  * mesh is one signature, so its own detail (a stack of fins) shows no
- * edge, and a few samples alias it.  The engine room's fins at 512 x 512,
- * depth 3: 2.83% per pixel with 2 x 2, 1.83% with 4 x 4 (Phase Two 5.7 to
- * 8.9 s), 1.67% with 8 x 8 (22 s). */
-#define DETAIL_GRID 4
+ * edge, and a few samples alias it.  Each 2 x 2 block of these samples
+ * shares one point's rays where direct light is seen by rays
+ * (direct_irradiance_split), which is where the fins are: on the engine
+ * room at 512 x 512, depth 3, 4 x 4 samples each with their own rays gave
+ * 1.64% per pixel in 6.4 s of Phase Two, 8 x 8 with their own 1.47% in
+ * 22 s, 8 x 8 sharing 1.47% in 8.8 s. */
+#define DETAIL_GRID 8
 /* Specular steps a signature follows.  Fixed, not the render's depth: the
  * images of levels 0..D must use the same samples as the depth-D image,
  * or they would not add up to it. */
@@ -162,7 +168,8 @@ static void note_light(const rscene *rs, seen_lights *s, int part)
     }
 }
 
-static int push_sample(const rscene *rs_of_row, p2_row *row, vec3f o, vec3f d, hit h, double w)
+static int push_sample(const rscene *rs_of_row, p2_row *row, vec3f o, vec3f d, hit h, double w,
+                       int light_split)
 {
     if (row->sample_count == row->sample_capacity) {
         size_t cap = row->sample_capacity ? 2 * row->sample_capacity : 1024;
@@ -172,7 +179,8 @@ static int push_sample(const rscene *rs_of_row, p2_row *row, vec3f o, vec3f d, h
         row->samples = ns;
         row->sample_capacity = cap;
     }
-    p2_sample s = {o, d, h.t, h.part, h.part < 0 ? -1 : zone_surface_of(rs_of_row, h.part), w};
+    p2_sample s = {o,      d, h.t, h.part, h.part < 0 ? -1 : zone_surface_of(rs_of_row, h.part),
+                   light_split, w};
     row->samples[row->sample_count++] = s;
     return 1;
 }
@@ -202,8 +210,9 @@ static int push_lights(p2_row *row, const seen_lights *s)
 
 /* Pushes pixel (px, py)'s g x g samples while they all have signature
  * `first`; sets *edge when one does not, *curved when one meets a sphere.
- * Returns 0 when out of memory. */
-static int grid_samples(const p2_ctx *c, int px, int py, int g, uint32_t first,
+ * With `split` each 2 x 2 block of samples shares the rays of one point's
+ * direct light (direct_irradiance_split).  Returns 0 when out of memory. */
+static int grid_samples(const p2_ctx *c, int px, int py, int g, int split, uint32_t first,
                         seen_lights *lights, p2_row *row, uint64_t *rays, int *edge, int *curved)
 {
     const rscene *rs = &c->r->rs;
@@ -215,7 +224,8 @@ static int grid_samples(const p2_ctx *c, int px, int py, int g, uint32_t first,
             if (ray_signature(rs, org, dir, rays, &h, curved, NULL) != first)
                 *edge = 1;
             note_light(rs, lights, h.part);
-            if (!*edge && !push_sample(rs, row, org, dir, h, 1.0 / (g * g)))
+            int ls = split ? 1 + (sx & 1) + 2 * (sy & 1) : 0;
+            if (!*edge && !push_sample(rs, row, org, dir, h, 1.0 / (g * g), ls))
                 return 0;
         }
     return 1;
@@ -313,7 +323,7 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
         cover_point(quasi, n, i, &u, &v);
         cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
         double w = (double)e->group_count[k] / ((double)e->group_shaded[k] * cells);
-        if (!push_sample(rs, row, org, dir, e->hits[i], w))
+        if (!push_sample(rs, row, org, dir, e->hits[i], w, 0))
             return 0;
     }
     /* Surfaces too small to meet the subset: the point nearest their
@@ -345,7 +355,7 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
         }
         cover_point(quasi, n, best, &u, &v);
         cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
-        if (!push_sample(rs, row, org, dir, e->hits[best], (double)e->group_count[k] / cells))
+        if (!push_sample(rs, row, org, dir, e->hits[best], (double)e->group_count[k] / cells, 0))
             return 0;
     }
     return 1;
@@ -371,6 +381,29 @@ static int fine_detail(const p2_ctx *c, const float ct[4], const p2_sample *s, s
         hi = fmaxf(hi, ct[k]);
     }
     return hi - lo > DETAIL_STEPS * c->pixel_angle * (s[0].t + c->screen_dist);
+}
+
+/* Whether sample s sees a diffuse surface that some light (switched on or
+ * off: the images of single lights use the same samples) lights through
+ * more occluders than direct light clips, so that it is seen by rays: a
+ * shadow that busy (the engine room's fins on its floor) can change within
+ * a pixel, so the pixel takes 2 x 2 samples sharing one point's rays. */
+static int busy_shadow(const p2_ctx *c, const p2_sample *s)
+{
+    const rscene *rs = &c->r->rs;
+    if (s->part < 0 || c->f->light_tree.elem_count > 0)
+        return 0;
+    rs_part tmp;
+    const rs_part *p = rs_prim(rs, s->part, &tmp);
+    if (p->is_light || !(rs->objects[p->object].weight[LOBE_DIFFUSE] > 0.0f))
+        return 0;
+    vec3f x = f3_madd(s->o, s->d, s->t), ng = shape_normal(p, x);
+    if (f3_dot(ng, s->d) > 0.0f)
+        ng = f3_neg(ng);
+    for (int i = 0; i < rs->light_count; i++)
+        if (direct_by_rays(&c->f->direct, rs->lights[i].part, f3_to_v3(x), f3_to_v3(ng)))
+            return 1;
+    return 0;
 }
 
 /* The samples of pixel (px, py) given its corner signatures. */
@@ -399,20 +432,27 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
             edge = ray_signature(rs, org, dir, rays, &h, NULL, NULL) != first;
         }
     }
-    if (!grid_samples(c, px, py, g, first, lights, row, rays, &edge, &curved))
+    if (!grid_samples(c, px, py, g, 0, first, lights, row, rays, &edge, &curved))
         return 0;
     if (!edge && curved && g < CURVED_GRID) {
         /* A sphere on the way: what the pixel sees (a reflection, a
          * refraction, shading over a curved surface) changes within it
          * faster than one sample can tell. */
         row->sample_count = start;
-        if (!grid_samples(c, px, py, CURVED_GRID, first, lights, row, rays, &edge, &curved))
+        if (!grid_samples(c, px, py, CURVED_GRID, 0, first, lights, row, rays, &edge, &curved))
             return 0;
     }
     if (!edge && !marked && g < DETAIL_GRID &&
         fine_detail(c, ct, row->samples + start, row->sample_count - start)) {
         row->sample_count = start;
-        if (!grid_samples(c, px, py, DETAIL_GRID, first, lights, row, rays, &edge, &curved))
+        if (!grid_samples(c, px, py, DETAIL_GRID, 1, first, lights, row, rays, &edge,
+                          &curved))
+            return 0;
+    }
+    if (!edge && !marked && g == 1 && row->sample_count - start == 1 &&
+        busy_shadow(c, &row->samples[start])) {
+        row->sample_count = start;
+        if (!grid_samples(c, px, py, 2, 1, first, lights, row, rays, &edge, &curved))
             return 0;
     }
     if (!edge && !marked)

@@ -287,6 +287,7 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
         const p2_sample *s = &px->s[i];
         if (s->surface != term->part)
             continue;
+        t->light_split = s->light_split;
         vec3 v;
         switch (term->type) {
         case P2_EMIT: {
@@ -301,6 +302,7 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
         }
         add(acc, s->w, v);
     }
+    t->light_split = 0;
 }
 
 void p2_reference(const p2_ctx *c, zone_trace *t, const p2_pixel *px, double acc[3])
@@ -310,7 +312,10 @@ void p2_reference(const p2_ctx *c, zone_trace *t, const p2_pixel *px, double acc
         for (int i = 0; i < px->nlights; i++)
             if (!f3_is_black(rs->objects[rs->parts[px->lights[i]].object].emission))
                 add(acc, 1.0, root_value(c, t, i, px));
-    for (int i = 0; i < px->n; i++)
+    for (int i = 0; i < px->n; i++) {
+        t->light_split = px->s[i].light_split;
         add(acc, px->s[i].w,
             zone_radiance(t, px->s[i].o, px->s[i].d, c->lo, c->hi, SHADE_FLAGS, NULL, 0));
+    }
+    t->light_split = 0;
 }

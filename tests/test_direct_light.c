@@ -1,0 +1,152 @@
+/* Exact direct light where the shadows are too busy to clip
+ * (zone/light/direct.h): a triangle light over a floor, with a comb of
+ * 2,500 small separate triangles between them (an OBJ mesh), so that a floor
+ * point under it has far more occluders than clipping takes and sees the
+ * light by rays.  Checked: the occluder search stops once it has more than
+ * it may return; the by-rays test says which points see the light by rays;
+ * the four split points (direct_irradiance_split, which Phase Two's
+ * sub-pixel samples use) together see what one point sees, within stated
+ * bounds, against a 64 times finer reference; and where the light is
+ * clipped exactly, splitting changes nothing.
+ *
+ * Needs nothing from ../shared. */
+#include "test_support.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geom/shapes.h"
+#include "render/render_internal.h"
+#include "zone/light/direct.h"
+#include "zone/light/occluders.h"
+#include "zone/zone.h"
+#include "zonetrace/render.h"
+#include "zonetrace/scene.h"
+
+#define TEETH 50    /* a side of the comb */
+#define PITCH 0.2
+#define TOOTH 0.12  /* a tooth's legs */
+#define COMB_Y 7.0
+
+static const char *write_comb(void)
+{
+    size_t cap = (size_t)TEETH * TEETH * 2 * 120 + 64;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    size_t len = 0;
+    int v = 1;
+    for (int i = 0; i < TEETH; i++)
+        for (int j = 0; j < TEETH; j++) {
+            double x = -5.0 + PITCH * i, z = -5.0 + PITCH * j;
+            len += (size_t)snprintf(text + len, cap - len,
+                                    "v %g %g %g\nv %g %g %g\nv %g %g %g\nf %d %d %d\n", x,
+                                    COMB_Y, z, x + TOOTH, COMB_Y, z, x, COMB_Y, z + TOOTH, v,
+                                    v + 1, v + 2);
+            v += 3;
+        }
+    const char *path = test_write_file("direct_comb.obj", text);
+    free(text);
+    return path;
+}
+
+static zt_renderer *comb_renderer(zt_scene **scene_out)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"camera\": {\"position\": [0, 8, -30], \"lookat\": [0, 0, 0], "
+             "\"up\": [0, 1, 0], \"fov\": 50, \"gridresolution\": [8, 8]}, \"scene\": ["
+             "{\"light\": {\"emission\": [10, 10, 10], \"backculled\": false, \"parts\": ["
+             "{\"lighttriangle\": {\"points\": [[-2, 10, -2], [2, 10, -2], [0, 10, 2]]}}]}},"
+             "{\"plane\": {\"normal\": [0, 1, 0], \"offset\": 0, " TEST_DIFFUSE(0.5) "}},"
+             "{\"mesh\": {\"file\": \"%s\", \"smooth\": false, \"backculled\": false, "
+             TEST_DIFFUSE(0.5) "}}]}",
+             write_comb());
+    zt_scene *scene = test_scene_text(text, "direct_comb.json");
+    *scene_out = scene;
+    return test_zone_renderer(scene, 1, 1, zt_render_options_default().quality);
+}
+
+static void test_query_stops_past_max(void **state)
+{
+    (void)state;
+    zt_scene *scene;
+    zt_renderer *r = comb_renderer(&scene);
+    const occluder_index *ix = r->forest->direct.occ;
+    occ_region all = {v3(-100, -100, -100), v3(100, 100, 100), 0, {{0, 0, 0}}, {0}};
+    int32_t out[DIRECT_MAX_OCCLUDERS];
+    /* The comb's 2,500 teeth and the light: more than max. */
+    assert_int_equal(occluders_query(ix, &all, out, 10), 11);
+    /* A region around one tooth: all of them, in ascending order. */
+    occ_region one = {v3(-5.01, COMB_Y - 0.01, -5.01), v3(-4.95, COMB_Y + 0.01, -4.95), 0,
+                      {{0, 0, 0}}, {0}};
+    int n = occluders_query(ix, &one, out, DIRECT_MAX_OCCLUDERS);
+    assert_true(n >= 1 && n <= DIRECT_MAX_OCCLUDERS);
+    for (int k = 1; k < n; k++)
+        assert_true(out[k - 1] < out[k]);
+    zt_renderer_release(r);
+    zt_scene_release(scene);
+}
+
+static void test_splits_share_the_rays(void **state)
+{
+    (void)state;
+    zt_scene *scene;
+    zt_renderer *r = comb_renderer(&scene);
+    const direct_ctx *c = &r->forest->direct;
+    assert_int_equal(r->rs.light_count, 1);
+    int light = r->rs.lights[0].part;
+    direct_ctx fine = *c;
+    fine.fallback = 64 * c->fallback;
+    vec3 up = v3(0, 1, 0);
+    int floor_part = -1;
+    for (int i = 0; i < r->rs.part_count; i++)
+        if (r->rs.parts[i].shape == SHAPE_PLANE)
+            floor_part = i;
+    assert_true(floor_part >= 0);
+
+    /* Under the comb: seen by rays.  Points across one tooth's shadow. */
+    double worst_split = 0, worst_one = 0;
+    int points = 0;
+    for (int i = 0; i < 8; i++) {
+        vec3 x = v3(0.01 + 0.025 * i, 0, 0.02 + 0.01 * i);
+        assert_true(direct_by_rays(c, light, x, up));
+        double one = direct_irradiance(c, light, x, up, floor_part);
+        double ref = direct_irradiance(&fine, light, x, up, floor_part);
+        double mean = 0;
+        for (int s = 1; s <= DIRECT_SPLITS; s++)
+            mean += direct_irradiance_split(c, light, x, up, floor_part, s) / DIRECT_SPLITS;
+        assert_true(ref > 0);
+        worst_split = fmax(worst_split, fabs(mean - ref) / ref);
+        worst_one = fmax(worst_one, fabs(one - ref) / ref);
+        /* The four quarters see the centres one point sees; they differ
+         * only by the weights of the quarters within a piece. */
+        assert_true(fabs(mean - one) <= 0.02 * one);
+        points++;
+    }
+    printf("%d points under the comb: one point %.2f%%, four splits %.2f%% from the fine "
+           "reference at worst\n",
+           points, 100 * worst_one, 100 * worst_split);
+    assert_true(worst_split < 0.10);
+
+    /* Beside the comb, nothing between the point and the light: clipped
+     * exactly, the same with any split. */
+    vec3 x = v3(30, 0, 0.5);
+    assert_false(direct_by_rays(c, light, x, up));
+    double exact = direct_irradiance(c, light, x, up, floor_part);
+    assert_true(exact > 0);
+    for (int s = 1; s <= DIRECT_SPLITS; s++)
+        assert_true(direct_irradiance_split(c, light, x, up, floor_part, s) == exact);
+    zt_renderer_release(r);
+    zt_scene_release(scene);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_query_stops_past_max),
+        cmocka_unit_test(test_splits_share_the_rays),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
