@@ -2,6 +2,7 @@
 #include "test_support.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -146,6 +147,55 @@ static void test_downsample(void **state)
     zt_image_release(src);
 }
 
+/* A reference with known noise: each value the truth 1 plus a uniform
+ * deviate of variance 0.01 (a fixed generator), its variance image 0.01.
+ * The truth's own error is about 0 (its raw error is the noise, 10%); an
+ * image 5% too bright has an own error of about 5%; both again over 4 x 4
+ * blocks.  Over 196,608 values the variance's estimate scatters by about
+ * 0.3% of itself, so the own error of the truth stays under 1%. */
+static void test_own_error(void **state)
+{
+    (void)state;
+    const int w = 256, h = 256;
+    const double sigma2 = 0.01, half = sqrt(3.0 * sigma2);
+    zt_image *ref = filled(w, h, 1.0f), *var = filled(w, h, (float)sigma2);
+    zt_image *truth = filled(w, h, 1.0f), *bright = filled(w, h, 1.05f);
+    uint64_t s = 88172645463325252ull;
+    for (size_t i = 0; i < (size_t)w * h * 3; i++) {
+        s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+        double u = (double)(s >> 11) / 9007199254740992.0;
+        ref->pixels[i] = (float)(1.0 + half * (2.0 * u - 1.0));
+    }
+    zt_compare_result r;
+    zt_error err = {0};
+    double own;
+    assert_int_equal(zt_image_compare(truth, ref, &r, &err), ZT_OK);
+    assert_close(r.rel_rmse, 0.1, 0.002);
+    assert_int_equal(zt_image_own_error(truth, ref, var, 1.0, &own, &err), ZT_OK);
+    assert_true(own < 0.01);
+    assert_int_equal(zt_image_own_error(bright, ref, var, 1.0, &own, &err), ZT_OK);
+    assert_close(own, 0.05, 0.005);
+
+    zt_image *im[4] = {ref, var, truth, bright}, *small[4];
+    for (int k = 0; k < 4; k++)
+        assert_non_null(small[k] = zt_image_downsample(im[k], 4));
+    assert_int_equal(zt_image_compare(small[2], small[0], &r, &err), ZT_OK);
+    assert_close(r.rel_rmse, 0.025, 0.002);
+    assert_int_equal(zt_image_own_error(small[2], small[0], small[1], 1.0 / 16, &own, &err),
+                     ZT_OK);
+    assert_true(own < 0.01);
+    assert_int_equal(zt_image_own_error(small[3], small[0], small[1], 1.0 / 16, &own, &err),
+                     ZT_OK);
+    assert_close(own, 0.05, 0.005);
+    /* A variance image of another size is refused. */
+    assert_int_equal(zt_image_own_error(truth, ref, small[1], 1.0, &own, &err),
+                     ZT_ERR_ARGUMENT);
+    for (int k = 0; k < 4; k++) {
+        zt_image_release(small[k]);
+        zt_image_release(im[k]);
+    }
+}
+
 static void test_create(void **state)
 {
     (void)state;
@@ -168,7 +218,7 @@ int main(void)
         cmocka_unit_test(test_constant_offset), cmocka_unit_test(test_identical),
         cmocka_unit_test(test_known_pixel),     cmocka_unit_test(test_black_reference),
         cmocka_unit_test(test_bad_arguments),   cmocka_unit_test(test_downsample),
-        cmocka_unit_test(test_create),
+        cmocka_unit_test(test_create),          cmocka_unit_test(test_own_error),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

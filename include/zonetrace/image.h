@@ -87,6 +87,17 @@ typedef struct zt_compare_result {
 zt_status zt_image_compare(const zt_image *a, const zt_image *b,
                            zt_compare_result *out, zt_error *err);
 
+/* a's own error against a noisy reference b: the relative RMSE with b's
+ * noise taken out, sqrt(max(0, sum (a-b)^2 - scale x sum variance)) /
+ * (sqrt(3 pixels) mean(b)), variance holding each pixel's variance of b's
+ * mean per channel (bench_reference --noise writes it).  An image equal to
+ * b's expectation scores 0 up to the noise of the variance estimate.  scale
+ * is 1 for the images as they are; for images averaged over k x k blocks
+ * (zt_image_downsample, the variance image too) it is 1 / k^2.  Fails with
+ * ZT_ERR_ARGUMENT when the sizes differ. */
+zt_status zt_image_own_error(const zt_image *a, const zt_image *b, const zt_image *variance,
+                             double scale, double *out, zt_error *err);
+
 /* A new image whose pixels are the means of factor x factor blocks of src
  * (the size must divide evenly).  NULL on bad arguments or out of memory. */
 zt_image *zt_image_downsample(const zt_image *src, int factor);

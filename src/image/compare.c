@@ -49,3 +49,26 @@ zt_status zt_image_compare(const zt_image *a, const zt_image *b,
         out->psnr = -INFINITY; /* no positive peak to speak of */
     return ZT_OK;
 }
+
+zt_status zt_image_own_error(const zt_image *a, const zt_image *b, const zt_image *variance,
+                             double scale, double *out, zt_error *err)
+{
+    zt_compare_result r;
+    zt_status st = zt_image_compare(a, b, &r, err);
+    if (st != ZT_OK)
+        return st;
+    if (!image_valid(variance) || !out || !(scale > 0))
+        return zt_fail(err, ZT_ERR_ARGUMENT, "own error: missing variance image or bad scale");
+    if (variance->width != b->width || variance->height != b->height)
+        return zt_fail(err, ZT_ERR_ARGUMENT,
+                       "own error: the variance image is %d x %d, the reference %d x %d",
+                       variance->width, variance->height, b->width, b->height);
+    size_t values = 3 * (size_t)b->width * (size_t)b->height;
+    double var = 0.0;
+    for (size_t i = 0; i < values; i++)
+        var += variance->pixels[i];
+    double mean_b = (r.mean_b[0] + r.mean_b[1] + r.mean_b[2]) / 3.0;
+    double own2 = r.rmse * r.rmse - scale * var / (double)values;
+    *out = mean_b != 0.0 ? sqrt(own2 > 0.0 ? own2 : 0.0) / mean_b : r.rel_rmse;
+    return ZT_OK;
+}

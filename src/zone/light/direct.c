@@ -516,6 +516,9 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
 /* Where the line from a through b meets the plane (pn, po). */
 int direct_by_rays(const direct_ctx *c, int light, vec3 x, vec3 n)
 {
+    /* A scene of few primitives (a Cornell box) never has too many. */
+    if (c->occ->prim_count <= DIRECT_MAX_OCCLUDERS)
+        return 0;
     zprim lpp;
     zprim_get(c->scene, c->rs, light, &lpp);
     light_frame f;

@@ -391,7 +391,8 @@ static int fine_detail(const p2_ctx *c, const float ct[4], const p2_sample *s, s
 static int busy_shadow(const p2_ctx *c, const p2_sample *s)
 {
     const rscene *rs = &c->r->rs;
-    if (s->part < 0 || c->f->light_tree.elem_count > 0)
+    if (s->part < 0 || c->f->light_tree.elem_count > 0 ||
+        c->f->direct.occ->prim_count <= DIRECT_MAX_OCCLUDERS)
         return 0;
     rs_part tmp;
     const rs_part *p = rs_prim(rs, s->part, &tmp);
