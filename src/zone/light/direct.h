@@ -38,13 +38,13 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
  * cost one point's rays and see as many directions.  Exact cuts are
  * unchanged. */
 #define DIRECT_SPLITS 4
+double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
+                               int split);
 
 /* Whether direct_irradiance sees light part `light` from x by rays (too
  * many occluders to clip): where a shadow is that busy, it may change
  * within a pixel. */
 int direct_by_rays(const direct_ctx *c, int light, vec3 x, vec3 n);
-double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
-                               int split);
 
 /* The fraction of a pixel (corners on the screen, in order around it) in
  * which the eye sees light part `light` directly, with exact occlusion:

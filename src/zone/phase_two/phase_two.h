@@ -46,7 +46,7 @@ typedef struct p2_sample {
     float t;        /* distance to its first hit */
     int part;       /* primitive first hit, -1: nothing */
     int surface;    /* its surface (zone_surface_of), -1: nothing */
-    int light_split;/* its share of the direct light's rays (zone_trace) */
+    int light_split; /* its share of the direct light's rays (zone_trace) */
     double w;       /* weight in the pixel (the weights of a pixel sum to 1) */
 } p2_sample;
 
