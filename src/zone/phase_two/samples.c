@@ -388,7 +388,9 @@ static int fine_detail(const p2_ctx *c, const float ct[4], const p2_sample *s, s
  * off: the images of single lights use the same samples) lights through
  * more occluders than direct light clips, so that it is seen by rays: a
  * shadow that busy (the engine room's fins on its floor) can change within
- * a pixel, so the pixel takes 2 x 2 samples sharing one point's rays. */
+ * a pixel, so the pixel takes 2 x 2 samples sharing one point's rays.
+ * Not made with a light tree (many light parts): a loop over them all
+ * per pixel would cost more than the samples. */
 static int busy_shadow(const p2_ctx *c, const p2_sample *s)
 {
     const rscene *rs = &c->r->rs;
