@@ -396,6 +396,29 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
     return set->overflow ? -1 : 1;
 }
 
+/* Piece (i, j) of the fan triangle (a, a + m e1, a + m e2) cut into m^2 by
+ * midpoints: the upright one, or with `up` the upside-down one beside it
+ * (none at a row's end: returns 0). */
+static int fan_piece(vec3 a, vec3 e1, vec3 e2, int i, int j, int up, int m, vec3 q[3])
+{
+    if (up && i + j + 1 >= m)
+        return 0;
+    vec3 base = v3_add(a, v3_add(v3_scale(e1, i), v3_scale(e2, j)));
+    if (!up) {
+        q[0] = base;
+        q[1] = v3_add(base, e1);
+        q[2] = v3_add(base, e2);
+    } else {
+        q[0] = v3_add(base, e1);
+        q[1] = v3_add(v3_add(base, e1), e2);
+        q[2] = v3_add(base, e2);
+    }
+    return 1;
+}
+
+/* Pieces whose rays' results by_rays keeps, to weigh the smaller side. */
+#define BY_RAYS_KEPT 1024
+
 /* The irradiance of polygon piece p (on the light's plane) at x, with
  * visibility by rays: p is cut into triangles of about 1/count of the
  * light each, and each counts if a ray from x reaches its centre.  With
@@ -414,8 +437,13 @@ static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p,
         split = 0;
     if (split)
         k--;
-    int m = 1 << k;
+    int m = 1 << k, pieces = fan * m * m;
     vec3f xo = ray_offset(v3_to_f3(x), v3_to_f3(n));
+    /* First every piece's ray; then Lambert's formula over the seen pieces
+     * or, when most are seen, over the whole polygon less the hidden ones:
+     * the formula costs more than a ray, and most points see all or none. */
+    unsigned char seen[BY_RAYS_KEPT];
+    int keep = pieces <= BY_RAYS_KEPT, seen_count = 0, at = 0;
     double e = 0;
     vec3 a = lift(f, p->x[0], p->y[0]);
     for (int t = 1; t + 1 < p->n; t++) {
@@ -424,21 +452,8 @@ static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p,
         for (int j = 0; j < m; j++)
             for (int i = 0; i + j < m; i++)
                 for (int up = 0; up < 2; up++) {
-                    if (up && i + j + 1 >= m)
-                        continue;
                     vec3 q[3];
-                    vec3 base = v3_add(a, v3_add(v3_scale(e1, i), v3_scale(e2, j)));
-                    if (!up) {
-                        q[0] = base;
-                        q[1] = v3_add(base, e1);
-                        q[2] = v3_add(base, e2);
-                    } else {
-                        q[0] = v3_add(base, e1);
-                        q[1] = v3_add(v3_add(base, e1), e2);
-                        q[2] = v3_add(base, e2);
-                    }
-                    double g = lambert_polygon(x, n, q, 3);
-                    if (!(g > 0))
+                    if (!fan_piece(a, e1, e2, i, j, up, m, q))
                         continue;
                     vec3 ctr = v3_scale(v3_add(v3_add(q[0], q[1]), q[2]), 1.0 / 3.0);
                     if (split >= 1 && split <= 3)
@@ -447,14 +462,43 @@ static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p,
                         ctr = v3_add(v3_scale(ctr, 0.5), v3_scale(q[split - 1], 0.5));
                     vec3f to = f3_sub(v3_to_f3(ctr), xo);
                     float dist = f3_length(to);
-                    if (!(dist > 0.0f))
-                        continue;
-                    if (!accel_occluded(c->rs, xo, f3_scale(to, 1.0f / dist), dist * 0.9999f,
-                                        background))
-                        e += g;
+                    int s = dist > 0.0f && !accel_occluded(c->rs, xo, f3_scale(to, 1.0f / dist),
+                                                          dist * 0.9999f, background);
+                    if (keep)
+                        seen[at++] = (unsigned char)s;
+                    else if (s)
+                        e += lambert_polygon(x, n, q, 3);
+                    seen_count += s;
                 }
     }
-    return e;
+    if (!keep)
+        return e;
+    if (seen_count == 0)
+        return 0;
+    int by_hidden = 2 * seen_count > pieces;
+    if (by_hidden) {
+        vec3 whole[POLY2_MAX];
+        for (int i = 0; i < p->n; i++)
+            whole[i] = lift(f, p->x[i], p->y[i]);
+        e = lambert_polygon(x, n, whole, p->n);
+    }
+    at = 0;
+    for (int t = 1; t + 1 < p->n; t++) {
+        vec3 b = lift(f, p->x[t], p->y[t]), cc = lift(f, p->x[t + 1], p->y[t + 1]);
+        vec3 e1 = v3_scale(v3_sub(b, a), 1.0 / m), e2 = v3_scale(v3_sub(cc, a), 1.0 / m);
+        for (int j = 0; j < m; j++)
+            for (int i = 0; i + j < m; i++)
+                for (int up = 0; up < 2; up++) {
+                    vec3 q[3];
+                    if (!fan_piece(a, e1, e2, i, j, up, m, q))
+                        continue;
+                    if (seen[at++] != by_hidden) {
+                        double g = lambert_polygon(x, n, q, 3);
+                        e += by_hidden ? -g : g;
+                    }
+                }
+    }
+    return e > 0 ? e : 0;
 }
 
 double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
