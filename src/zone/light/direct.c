@@ -396,24 +396,54 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
     return set->overflow ? -1 : 1;
 }
 
-/* Piece (i, j) of the fan triangle (a, a + m e1, a + m e2) cut into m^2 by
- * midpoints: the upright one, or with `up` the upside-down one beside it
- * (none at a row's end: returns 0). */
-static int fan_piece(vec3 a, vec3 e1, vec3 e2, int i, int j, int up, int m, vec3 q[3])
+/* The pieces of convex polygon p (on the light's plane) in order: each
+ * triangle of its fan from vertex 0 cut into m^2 by midpoints, row by row,
+ * each upright piece followed by the upside-down one beside it. */
+typedef struct fan_walk {
+    const light_frame *f;
+    const poly2 *p;
+    int m, t, j, i, up;
+    vec3 a, e1, e2;
+} fan_walk;
+
+static void fan_start(fan_walk *w, const light_frame *f, const poly2 *p, int m)
 {
-    if (up && i + j + 1 >= m)
-        return 0;
-    vec3 base = v3_add(a, v3_add(v3_scale(e1, i), v3_scale(e2, j)));
-    if (!up) {
-        q[0] = base;
-        q[1] = v3_add(base, e1);
-        q[2] = v3_add(base, e2);
-    } else {
-        q[0] = v3_add(base, e1);
-        q[1] = v3_add(v3_add(base, e1), e2);
-        q[2] = v3_add(base, e2);
+    *w = (fan_walk){.f = f, .p = p, .m = m, .a = lift(f, p->x[0], p->y[0])};
+}
+
+/* The next piece into q; 0 when there are no more. */
+static int fan_next(fan_walk *w, vec3 q[3])
+{
+    for (;;) {
+        if (w->t == 0 || w->j >= w->m) {
+            if (++w->t + 1 >= w->p->n)
+                return 0;
+            vec3 b = lift(w->f, w->p->x[w->t], w->p->y[w->t]);
+            vec3 c = lift(w->f, w->p->x[w->t + 1], w->p->y[w->t + 1]);
+            w->e1 = v3_scale(v3_sub(b, w->a), 1.0 / w->m);
+            w->e2 = v3_scale(v3_sub(c, w->a), 1.0 / w->m);
+            w->j = w->i = w->up = 0;
+        }
+        if (w->i + w->j >= w->m) {
+            w->j++;
+            w->i = w->up = 0;
+            continue;
+        }
+        int i = w->i, j = w->j, up = w->up;
+        if (up) {
+            w->up = 0;
+            w->i++;
+            if (i + j + 1 >= w->m)
+                continue; /* no upside-down piece at a row's end */
+        } else {
+            w->up = 1;
+        }
+        vec3 base = v3_add(w->a, v3_add(v3_scale(w->e1, i), v3_scale(w->e2, j)));
+        q[0] = up ? v3_add(base, w->e1) : base;
+        q[1] = up ? v3_add(v3_add(base, w->e1), w->e2) : v3_add(base, w->e1);
+        q[2] = v3_add(base, w->e2);
+        return 1;
     }
-    return 1;
 }
 
 /* Pieces whose rays' results by_rays keeps, to weigh the smaller side. */
@@ -445,31 +475,24 @@ static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p,
     unsigned char seen[BY_RAYS_KEPT];
     int keep = pieces <= BY_RAYS_KEPT, seen_count = 0, at = 0;
     double e = 0;
-    vec3 a = lift(f, p->x[0], p->y[0]);
-    for (int t = 1; t + 1 < p->n; t++) {
-        vec3 b = lift(f, p->x[t], p->y[t]), cc = lift(f, p->x[t + 1], p->y[t + 1]);
-        vec3 e1 = v3_scale(v3_sub(b, a), 1.0 / m), e2 = v3_scale(v3_sub(cc, a), 1.0 / m);
-        for (int j = 0; j < m; j++)
-            for (int i = 0; i + j < m; i++)
-                for (int up = 0; up < 2; up++) {
-                    vec3 q[3];
-                    if (!fan_piece(a, e1, e2, i, j, up, m, q))
-                        continue;
-                    vec3 ctr = v3_scale(v3_add(v3_add(q[0], q[1]), q[2]), 1.0 / 3.0);
-                    if (split >= 1 && split <= 3)
-                        /* (4 q_s + the other two) / 6: the centre of the
-                         * quarter at corner s. */
-                        ctr = v3_add(v3_scale(ctr, 0.5), v3_scale(q[split - 1], 0.5));
-                    vec3f to = f3_sub(v3_to_f3(ctr), xo);
-                    float dist = f3_length(to);
-                    int s = dist > 0.0f && !accel_occluded(c->rs, xo, f3_scale(to, 1.0f / dist),
-                                                          dist * 0.9999f, background);
-                    if (keep)
-                        seen[at++] = (unsigned char)s;
-                    else if (s)
-                        e += lambert_polygon(x, n, q, 3);
-                    seen_count += s;
-                }
+    fan_walk w;
+    vec3 q[3];
+    fan_start(&w, f, p, m);
+    while (fan_next(&w, q)) {
+        vec3 ctr = v3_scale(v3_add(v3_add(q[0], q[1]), q[2]), 1.0 / 3.0);
+        if (split >= 1 && split <= 3)
+            /* (4 q_s + the other two) / 6: the centre of the quarter at
+             * corner s. */
+            ctr = v3_add(v3_scale(ctr, 0.5), v3_scale(q[split - 1], 0.5));
+        vec3f to = f3_sub(v3_to_f3(ctr), xo);
+        float dist = f3_length(to);
+        int s = dist > 0.0f &&
+                !accel_occluded(c->rs, xo, f3_scale(to, 1.0f / dist), dist * 0.9999f, background);
+        if (keep)
+            seen[at++] = (unsigned char)s;
+        else if (s)
+            e += lambert_polygon(x, n, q, 3);
+        seen_count += s;
     }
     if (!keep)
         return e;
@@ -483,21 +506,12 @@ static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p,
         e = lambert_polygon(x, n, whole, p->n);
     }
     at = 0;
-    for (int t = 1; t + 1 < p->n; t++) {
-        vec3 b = lift(f, p->x[t], p->y[t]), cc = lift(f, p->x[t + 1], p->y[t + 1]);
-        vec3 e1 = v3_scale(v3_sub(b, a), 1.0 / m), e2 = v3_scale(v3_sub(cc, a), 1.0 / m);
-        for (int j = 0; j < m; j++)
-            for (int i = 0; i + j < m; i++)
-                for (int up = 0; up < 2; up++) {
-                    vec3 q[3];
-                    if (!fan_piece(a, e1, e2, i, j, up, m, q))
-                        continue;
-                    if (seen[at++] != by_hidden) {
-                        double g = lambert_polygon(x, n, q, 3);
-                        e += by_hidden ? -g : g;
-                    }
-                }
-    }
+    fan_start(&w, f, p, m);
+    while (fan_next(&w, q))
+        if (seen[at++] != by_hidden) {
+            double g = lambert_polygon(x, n, q, 3);
+            e += by_hidden ? -g : g;
+        }
     return e > 0 ? e : 0;
 }
 
