@@ -39,7 +39,7 @@
  * (direct_irradiance_split), which is where the fins are: on the engine
  * room at 512 x 512, depth 3, 4 x 4 samples each with their own rays gave
  * 1.64% per pixel in 6.4 s of Phase Two, 8 x 8 with their own 1.47% in
- * 24 s (before the occluder search stopped early), 8 x 8 sharing 1.47% in
+ * 24 s (without the occluder search's early stop), 8 x 8 sharing 1.47% in
  * 8.8 s. */
 #define DETAIL_GRID 8
 /* Specular steps a signature follows.  Fixed, not the render's depth: the
