@@ -65,17 +65,7 @@ static const char *sheet_scene(void)
     enum { SQUARES = 30 };
     static char obj[(SQUARES + 1) * (SQUARES + 1) * 40 + SQUARES * SQUARES * 80 + 64];
     size_t len = (size_t)snprintf(obj, sizeof obj, "vn 0 -1 0\n");
-    for (int i = 0; i <= SQUARES; i++)
-        for (int j = 0; j <= SQUARES; j++)
-            len += (size_t)snprintf(obj + len, sizeof obj - len, "v %g 20 %g\n", 0.5 * j,
-                                    0.5 * i);
-    for (int i = 0; i < SQUARES; i++)
-        for (int j = 0; j < SQUARES; j++) {
-            int a = 1 + i * (SQUARES + 1) + j, b = a + 1, c = a + SQUARES + 1, d = c + 1;
-            len += (size_t)snprintf(obj + len, sizeof obj - len,
-                                    "f %d//1 %d//1 %d//1\nf %d//1 %d//1 %d//1\n", a, b, d, a,
-                                    d, c);
-        }
+    test_obj_sheet(obj, len, sizeof obj, SQUARES, 0.5, 20, 1);
     char objpath[1024], text[2048];
     snprintf(objpath, sizeof objpath, "%s", test_write_file("job_sheet.obj", obj));
     snprintf(text, sizeof text,

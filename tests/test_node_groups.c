@@ -33,23 +33,6 @@
 #define RADIUS 2.0      /* the groups the test makes itself */
 #define MIN_COS 0.9
 
-static size_t write_grid(char *text, size_t len, size_t cap, int squares, double y, int first)
-{
-    for (int i = 0; i <= squares; i++)
-        for (int j = 0; j <= squares; j++)
-            len += (size_t)snprintf(text + len, cap - len, "v %g %g %g\n", STEP * j, y,
-                                    STEP * i);
-    for (int i = 0; i < squares; i++)
-        for (int j = 0; j < squares; j++) {
-            int a = first + i * (squares + 1) + j, b = a + 1, c = a + squares + 1, d = c + 1;
-            /* Counter-clockwise seen from -y: facing down. */
-            len += (size_t)snprintf(text + len, cap - len,
-                                    "f %d//1 %d//1 %d//1\nf %d//1 %d//1 %d//1\n", a, b, d, a, d,
-                                    c);
-        }
-    return len;
-}
-
 static const char *write_sheets(void)
 {
     int vb = (BIG + 1) * (BIG + 1), vs = (SMALL + 1) * (SMALL + 1);
@@ -57,8 +40,8 @@ static const char *write_sheets(void)
     char *text = malloc(cap);
     assert_non_null(text);
     size_t len = (size_t)snprintf(text, cap, "vn 0 -1 0\n");
-    len = write_grid(text, len, cap, BIG, HIGH, 1);
-    write_grid(text, len, cap, SMALL, HIGH - GAP, 1 + vb);
+    len = test_obj_sheet(text, len, cap, BIG, STEP, HIGH, 1);
+    test_obj_sheet(text, len, cap, SMALL, STEP, HIGH - GAP, 1 + vb);
     const char *path = test_write_file("group_sheets.obj", text);
     free(text);
     return path;

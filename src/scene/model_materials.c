@@ -127,9 +127,6 @@ static int copy_texels(const struct aiTexture *t, mesh_texture *out, char *why, 
     return 1;
 }
 
-/* Decodes the texture the material names ("*N" for the file's embedded
- * texture N, else a file name relative to the model).  Returns 1, or 0 with
- * the reason. */
 /* printf into a buffer, cut to its size: the names and reasons a model
  * file supplies may be longer than a message needs. */
 static void clip_text(char *to, size_t n, const char *fmt, ...)
@@ -142,6 +139,9 @@ static void clip_text(char *to, size_t n, const char *fmt, ...)
     va_end(ap);
 }
 
+/* Decodes the texture the material names ("*N" for the file's embedded
+ * texture N, else a file name relative to the model).  Returns 1, or 0 with
+ * the reason. */
 static int load_texture(const struct aiScene *sc, const char *folder, const char *name,
                         mesh_texture *out, char *why, size_t n)
 {

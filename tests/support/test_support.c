@@ -64,6 +64,23 @@ const char *test_write_file(const char *name, const char *text)
     return path;
 }
 
+size_t test_obj_sheet(char *text, size_t len, size_t cap, int squares, double step, double y,
+                      int first)
+{
+    for (int i = 0; i <= squares; i++)
+        for (int j = 0; j <= squares; j++)
+            len += (size_t)snprintf(text + len, cap - len, "v %g %g %g\n", step * j, y, step * i);
+    for (int i = 0; i < squares; i++)
+        for (int j = 0; j < squares; j++) {
+            int a = first + i * (squares + 1) + j, b = a + 1, c = a + squares + 1, d = c + 1;
+            /* Counter-clockwise seen from -y: facing down. */
+            len += (size_t)snprintf(text + len, cap - len,
+                                    "f %d//1 %d//1 %d//1\nf %d//1 %d//1 %d//1\n", a, b, d, a, d,
+                                    c);
+        }
+    return len;
+}
+
 char *test_read_file(const char *path, size_t *length)
 {
     FILE *f = fopen(path, "rb");

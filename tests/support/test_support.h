@@ -33,6 +33,14 @@ const char *test_tmp_path(const char *name);
 /* Writes text to tmp_dir/name and returns that path. */
 const char *test_write_file(const char *name, const char *text);
 
+/* Appends to OBJ text (length len, room cap) a sheet of squares x squares
+ * squares of side step in the plane at height y, from the origin along x
+ * and z, its vertices numbered from `first`, two triangles a square facing
+ * down through normal 1 (the caller writes "vn 0 -1 0").  Returns the new
+ * length. */
+size_t test_obj_sheet(char *text, size_t len, size_t cap, int squares, double step, double y,
+                      int first);
+
 /* Runs the zonetrace program with the given arguments (a shell-quoted
  * string), capturing stderr into *err_out (malloc'd, may be NULL) and
  * returning the exit status (or -1 if it died from a signal). */
