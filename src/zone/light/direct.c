@@ -553,7 +553,11 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
     if (pieces[0].n < 3)
         return 0;
     poly2 whole = pieces[0];
-    int cut = cut_occluders(c, light, &f, x, n, receiver, &set, &scratch);
+    /* Split points are only taken where shadows are busy, and there the
+     * search nearly always finds too many: it is skipped (direct.h). */
+    int cut = split > 0 && c->occ->prim_count > DIRECT_MAX_OCCLUDERS
+                  ? -1
+                  : cut_occluders(c, light, &f, x, n, receiver, &set, &scratch);
     if (cut < 0)
         return by_rays(c, &f, &whole, x, n, lp->background, c->fallback, split);
     if (cut == 0)
@@ -571,7 +575,6 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
     return e;
 }
 
-/* Where the line from a through b meets the plane (pn, po). */
 int direct_by_rays(const direct_ctx *c, int light, vec3 x, vec3 n)
 {
     /* A scene of few primitives (a Cornell box) never has too many. */
@@ -594,6 +597,7 @@ int direct_by_rays(const direct_ctx *c, int light, vec3 x, vec3 n)
     return occluders_query(c->occ, &region, cand, DIRECT_MAX_OCCLUDERS) > DIRECT_MAX_OCCLUDERS;
 }
 
+/* Where the line from a through b meets the plane (pn, po). */
 static vec3 through_plane(vec3 a, vec3 b, vec3 pn, double po)
 {
     vec3 d = v3_sub(b, a);

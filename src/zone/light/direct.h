@@ -33,10 +33,14 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
                          int receiver);
 
 /* The same for one of four points side by side (split 1..4; 0 is the call
- * above) that share the fallback's rays: where the light is seen by rays,
- * each point takes a quarter of the pieces' centres, so the four together
- * cost one point's rays and see as many directions.  Exact cuts are
- * unchanged. */
+ * above) that share the fallback's rays: each point takes a quarter of the
+ * pieces' centres, so the four together cost one point's rays and see as
+ * many directions.  A split point always sees the light by rays, without
+ * searching for occluders, unless the scene has no more primitives than
+ * are clipped exactly: Phase Two splits only where shadows are busy (a
+ * mesh's detail, a busy shadow), and there the search nearly always finds
+ * too many.  On the engine room skipping it takes Phase Two from 8.4 s to
+ * 6.3 s, and changes 367 pixels by at most 0.4%. */
 #define DIRECT_SPLITS 4
 double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
                                int split);
