@@ -346,7 +346,9 @@ uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_s
             /* Inside a closed object most directions meet a back face. */
             vec3 o = v3_add(x, v3_scale(n, 1e-4 * h));
             int inside = 0;
-            for (int p = 0; p < PROBES; p++) {
+            /* (Until the majority is settled: the same answer.) */
+            for (int p = 0; p < PROBES && 2 * inside < PROBES && 2 * (p - inside) <= PROBES;
+                 p++) {
                 int back = 0;
                 int hit = node_life_first_hit(occ, scene, rs, o, probe_dir(n, p), &back);
                 rays++;
