@@ -54,18 +54,23 @@ static const char *write_comb(void)
     return path;
 }
 
-static zt_renderer *comb_renderer(zt_scene **scene_out)
+#define TRIANGLE_LIGHT                                                                         \
+    "{\"light\": {\"emission\": [10, 10, 10], \"backculled\": false, \"parts\": ["             \
+    "{\"lighttriangle\": {\"points\": [[-2, 10, -2], [2, 10, -2], [0, 10, 2]]}}]}},"
+#define SPHERE_LIGHT                                                                           \
+    "{\"lightsphere\": {\"center\": [0, 10, 0], \"radius\": 1.5, \"emission\": [10, 10, 10]}},"
+
+/* The comb under `light`, one of the two above. */
+static zt_renderer *comb_renderer(zt_scene **scene_out, const char *light)
 {
     char text[2048];
     snprintf(text, sizeof text,
              "{\"camera\": {\"position\": [0, 8, -30], \"lookat\": [0, 0, 0], "
-             "\"up\": [0, 1, 0], \"fov\": 50, \"gridresolution\": [8, 8]}, \"scene\": ["
-             "{\"light\": {\"emission\": [10, 10, 10], \"backculled\": false, \"parts\": ["
-             "{\"lighttriangle\": {\"points\": [[-2, 10, -2], [2, 10, -2], [0, 10, 2]]}}]}},"
+             "\"up\": [0, 1, 0], \"fov\": 50, \"gridresolution\": [8, 8]}, \"scene\": [%s"
              "{\"plane\": {\"normal\": [0, 1, 0], \"offset\": 0, " TEST_DIFFUSE(0.5) "}},"
              "{\"mesh\": {\"file\": \"%s\", \"smooth\": false, \"backculled\": false, "
              TEST_DIFFUSE(0.5) "}}]}",
-             write_comb());
+             light, write_comb());
     zt_scene *scene = test_scene_text(text, "direct_comb.json");
     *scene_out = scene;
     return test_zone_renderer(scene, 1, 1, zt_render_options_default().quality);
@@ -75,7 +80,7 @@ static void test_query_stops_past_max(void **state)
 {
     (void)state;
     zt_scene *scene;
-    zt_renderer *r = comb_renderer(&scene);
+    zt_renderer *r = comb_renderer(&scene, TRIANGLE_LIGHT);
     const occluder_index *ix = r->forest->direct.occ;
     occ_region all = {v3(-100, -100, -100), v3(100, 100, 100), 0, {{0, 0, 0}}, {0}};
     int32_t out[DIRECT_MAX_OCCLUDERS];
@@ -96,7 +101,7 @@ static void test_splits_share_the_rays(void **state)
 {
     (void)state;
     zt_scene *scene;
-    zt_renderer *r = comb_renderer(&scene);
+    zt_renderer *r = comb_renderer(&scene, TRIANGLE_LIGHT);
     const direct_ctx *c = &r->forest->direct;
     assert_int_equal(r->rs.light_count, 1);
     int light = r->rs.lights[0].part;
@@ -161,10 +166,46 @@ static void test_splits_share_the_rays(void **state)
     double mean = 0;
     for (int s = 1; s <= DIRECT_SPLITS; s++)
         mean += direct_irradiance_split(c, light, x, up, floor_part, s) / DIRECT_SPLITS;
-    printf("at the comb's edge: unhidden %.5g, exact %.5g, split points by rays %.5g (%.2f%%)\n", open, exact, mean,
-           100 * fabs(mean - exact) / exact);
+    printf("at the comb's edge: unhidden %.5g, exact %.5g, split points by rays %.5g (%.2f%%)\n",
+           open, exact, mean, 100 * fabs(mean - exact) / exact);
     assert_true(exact > 0.5 * open && exact < 0.99 * open);
     assert_true(fabs(mean - exact) <= 0.02 * exact);
+    zt_renderer_release(r);
+    zt_scene_release(scene);
+}
+
+/* A sphere light's pieces lie on its silhouette's disc, inside the
+ * sphere: seen by rays, the light must not hide itself.  Beside the comb a
+ * split point sees all of it, as the exact cut does; under the comb, by
+ * rays, what the teeth leave of it. */
+static void test_sphere_light_by_rays(void **state)
+{
+    (void)state;
+    zt_scene *scene;
+    zt_renderer *r = comb_renderer(&scene, SPHERE_LIGHT);
+    const direct_ctx *c = &r->forest->direct;
+    assert_int_equal(r->rs.light_count, 1);
+    int light = r->rs.lights[0].part, floor_part = -1;
+    for (int i = 0; i < r->rs.part_count; i++)
+        if (r->rs.parts[i].shape == SHAPE_PLANE)
+            floor_part = i;
+    vec3 up = v3(0, 1, 0), x = v3(30, 0, 0.5);
+    double exact = direct_irradiance(c, light, x, up, floor_part);
+    assert_true(exact > 0);
+    for (int s = 1; s <= DIRECT_SPLITS; s++)
+        assert_true(fabs(direct_irradiance_split(c, light, x, up, floor_part, s) - exact) <=
+                    1e-9 * exact);
+    x = v3(0.01, 0, 0.02);
+    assert_true(direct_by_rays(c, light, x, up));
+    double under = direct_irradiance(c, light, x, up, floor_part);
+    /* Unhidden, a sphere of radius r at distance D straight above gives
+     * pi (r / D)^2 per unit radiance; the comb's teeth cover 18% of its
+     * plane. */
+    vec3 d = v3_sub(v3(0, 10, 0), x);
+    double unhidden = 3.14159265358979 * 1.5 * 1.5 / v3_dot(d, d) * d.y / v3_length(d);
+    printf("sphere light under the comb, by rays: %.5g, unhidden %.5g (%.1f%% seen)\n", under,
+           unhidden, 100 * under / unhidden);
+    assert_true(under > 0.6 * unhidden && under < 0.95 * unhidden);
     zt_renderer_release(r);
     zt_scene_release(scene);
 }
@@ -174,6 +215,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_query_stops_past_max),
         cmocka_unit_test(test_splits_share_the_rays),
+        cmocka_unit_test(test_sphere_light_by_rays),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -446,6 +446,19 @@ static int fan_next(fan_walk *w, vec3 q[3])
     }
 }
 
+/* A sphere light's pieces lie on its silhouette's disc, inside the sphere:
+ * a ray towards one ends where it enters the sphere (or at the disc, if
+ * it somehow misses), so the light does not hide itself. */
+static float sphere_entry(const zprim *lp, vec3f o, vec3f d, float dist)
+{
+    vec3 oc = v3_sub(lp->p[0], f3_to_v3(o)), dd = f3_to_v3(d);
+    double b = v3_dot(dd, oc), disc = b * b - (v3_dot(oc, oc) - lp->radius * lp->radius);
+    if (disc < 0)
+        return dist;
+    double t = b - sqrt(disc);
+    return t > 0 && t < dist ? (float)t : dist;
+}
+
 /* Pieces whose rays' results by_rays keeps, to weigh the smaller side. */
 #define BY_RAYS_KEPT 1024
 
@@ -456,8 +469,8 @@ static int fan_next(fan_walk *w, vec3 q[3])
  * the centre of their quarter s (corner s, or the middle for 4): four
  * points with splits 1..4 side by side see, between them, the centres of the
  * finer triangles. */
-static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p, vec3 x, vec3 n,
-                      int background, int count, int split)
+static double by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, const poly2 *p,
+                      vec3 x, vec3 n, int count, int split)
 {
     /* Fan triangles, each cut into 4^k by midpoints. */
     int fan = p->n - 2, k = 0;
@@ -486,8 +499,13 @@ static double by_rays(const direct_ctx *c, const light_frame *f, const poly2 *p,
             ctr = v3_add(v3_scale(ctr, 0.5), v3_scale(q[split - 1], 0.5));
         vec3f to = f3_sub(v3_to_f3(ctr), xo);
         float dist = f3_length(to);
-        int s = dist > 0.0f &&
-                !accel_occluded(c->rs, xo, f3_scale(to, 1.0f / dist), dist * 0.9999f, background);
+        int s = 0;
+        if (dist > 0.0f) {
+            vec3f d = f3_scale(to, 1.0f / dist);
+            if (lp->shape == SHAPE_SPHERE)
+                dist = sphere_entry(lp, xo, d, dist);
+            s = !accel_occluded(c->rs, xo, d, dist * 0.9999f, lp->background);
+        }
         if (keep)
             seen[at++] = (unsigned char)s;
         else if (s)
@@ -559,7 +577,7 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
                   ? -1
                   : cut_occluders(c, light, &f, x, n, receiver, &set, &scratch);
     if (cut < 0)
-        return by_rays(c, &f, &whole, x, n, lp->background, c->fallback, split);
+        return by_rays(c, lp, &f, &whole, x, n, c->fallback, split);
     if (cut == 0)
         return 0;
     double e = 0;
