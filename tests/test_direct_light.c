@@ -76,6 +76,33 @@ static zt_renderer *comb_renderer(zt_scene **scene_out, const char *light)
     return test_zone_renderer(scene, 1, 1, zt_render_options_default().quality);
 }
 
+/* The comb under `light`, with its one light part and its floor. */
+static zt_renderer *comb_lit(const char *light, zt_scene **scene, int *light_part,
+                             int *floor_part)
+{
+    zt_renderer *r = comb_renderer(scene, light);
+    assert_int_equal(r->rs.light_count, 1);
+    *light_part = r->rs.lights[0].part;
+    *floor_part = -1;
+    for (int i = 0; i < r->rs.part_count; i++)
+        if (r->rs.parts[i].shape == SHAPE_PLANE)
+            *floor_part = i;
+    assert_true(*floor_part >= 0);
+    return r;
+}
+
+/* Where nothing stands between x and the light, a split point, which sees
+ * by rays whatever the search would find, sees all of it: Lambert's formula
+ * over the whole light, as the exact cut takes. */
+static void assert_splits_see_all(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver)
+{
+    double exact = direct_irradiance(c, light, x, n, receiver);
+    assert_true(exact > 0);
+    for (int s = 1; s <= DIRECT_SPLITS; s++)
+        assert_true(fabs(direct_irradiance_split(c, light, x, n, receiver, s) - exact) <=
+                    1e-9 * exact);
+}
+
 static void test_query_stops_past_max(void **state)
 {
     (void)state;
@@ -101,10 +128,9 @@ static void test_splits_share_the_rays(void **state)
 {
     (void)state;
     zt_scene *scene;
-    zt_renderer *r = comb_renderer(&scene, TRIANGLE_LIGHT);
+    int light, floor_part;
+    zt_renderer *r = comb_lit(TRIANGLE_LIGHT, &scene, &light, &floor_part);
     const direct_ctx *c = &r->forest->direct;
-    assert_int_equal(r->rs.light_count, 1);
-    int light = r->rs.lights[0].part;
     direct_ctx fine = *c, kept = *c;
     fine.fallback = 64 * c->fallback;
     /* Up to 1,024 pieces the rays' results are kept and the smaller side
@@ -112,11 +138,6 @@ static void test_splits_share_the_rays(void **state)
      * its ray returns.  The two ways must agree to the pieces' size. */
     kept.fallback = 16 * c->fallback;
     vec3 up = v3(0, 1, 0);
-    int floor_part = -1;
-    for (int i = 0; i < r->rs.part_count; i++)
-        if (r->rs.parts[i].shape == SHAPE_PLANE)
-            floor_part = i;
-    assert_true(floor_part >= 0);
 
     /* Under the comb: seen by rays.  Points across one tooth's shadow. */
     double worst_split = 0, worst_one = 0, worst_fine = 0;
@@ -146,21 +167,16 @@ static void test_splits_share_the_rays(void **state)
     assert_true(worst_fine < 0.05); /* 2.1% measured: the pieces' size */
 
     /* Beside the comb, nothing between the point and the light: clipped
-     * exactly, and a split point, which sees by rays whatever the search
-     * would find, sees all of it (Lambert's formula over the whole light). */
+     * exactly, and all of it seen by the split points. */
     vec3 x = v3(30, 0, 0.5);
     assert_false(direct_by_rays(c, light, x, up));
-    double exact = direct_irradiance(c, light, x, up, floor_part);
-    assert_true(exact > 0);
-    for (int s = 1; s <= DIRECT_SPLITS; s++)
-        assert_true(fabs(direct_irradiance_split(c, light, x, up, floor_part, s) - exact) <=
-                    1e-9 * exact);
+    assert_splits_see_all(c, light, x, up, floor_part);
     /* At the comb's edge a few teeth, few enough to clip, hide 3% of the
      * light: the split points by rays agree with the exact value to the
      * pieces' size (0.6% measured). */
     x = v3(18, 0, 0.5);
     assert_false(direct_by_rays(c, light, x, up));
-    exact = direct_irradiance(c, light, x, up, floor_part);
+    double exact = direct_irradiance(c, light, x, up, floor_part);
     vec3 tri[3] = {v3(-2, 10, -2), v3(2, 10, -2), v3(0, 10, 2)};
     double open = lambert_polygon(x, up, tri, 3); /* the light unhidden */
     double mean = 0;
@@ -182,20 +198,12 @@ static void test_sphere_light_by_rays(void **state)
 {
     (void)state;
     zt_scene *scene;
-    zt_renderer *r = comb_renderer(&scene, SPHERE_LIGHT);
+    int light, floor_part;
+    zt_renderer *r = comb_lit(SPHERE_LIGHT, &scene, &light, &floor_part);
     const direct_ctx *c = &r->forest->direct;
-    assert_int_equal(r->rs.light_count, 1);
-    int light = r->rs.lights[0].part, floor_part = -1;
-    for (int i = 0; i < r->rs.part_count; i++)
-        if (r->rs.parts[i].shape == SHAPE_PLANE)
-            floor_part = i;
-    vec3 up = v3(0, 1, 0), x = v3(30, 0, 0.5);
-    double exact = direct_irradiance(c, light, x, up, floor_part);
-    assert_true(exact > 0);
-    for (int s = 1; s <= DIRECT_SPLITS; s++)
-        assert_true(fabs(direct_irradiance_split(c, light, x, up, floor_part, s) - exact) <=
-                    1e-9 * exact);
-    x = v3(0.01, 0, 0.02);
+    vec3 up = v3(0, 1, 0);
+    assert_splits_see_all(c, light, v3(30, 0, 0.5), up, floor_part);
+    vec3 x = v3(0.01, 0, 0.02);
     assert_true(direct_by_rays(c, light, x, up));
     double under = direct_irradiance(c, light, x, up, floor_part);
     /* Unhidden, a sphere of radius r at distance D straight above gives
