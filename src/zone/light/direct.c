@@ -459,6 +459,13 @@ static float sphere_entry(const zprim *lp, vec3f o, vec3f d, float dist)
     return t > 0 && t < dist ? (float)t : dist;
 }
 
+/* Whether the scene has no more primitives than are clipped exactly: then
+ * no point sees a light by rays (a Cornell box). */
+static int clips_every_point(const direct_ctx *c)
+{
+    return c->occ->prim_count <= DIRECT_MAX_OCCLUDERS;
+}
+
 /* Pieces whose rays' results by_rays keeps, to weigh the smaller side. */
 #define BY_RAYS_KEPT 1024
 
@@ -573,7 +580,7 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
     poly2 whole = pieces[0];
     /* Split points are only taken where shadows are busy, and there the
      * search nearly always finds too many: it is skipped (direct.h). */
-    int cut = split > 0 && c->occ->prim_count > DIRECT_MAX_OCCLUDERS
+    int cut = split > 0 && !clips_every_point(c)
                   ? -1
                   : cut_occluders(c, light, &f, x, n, receiver, &set, &scratch);
     if (cut < 0)
@@ -595,8 +602,7 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
 
 int direct_by_rays(const direct_ctx *c, int light, vec3 x, vec3 n)
 {
-    /* A scene of few primitives (a Cornell box) never has too many. */
-    if (c->occ->prim_count <= DIRECT_MAX_OCCLUDERS)
+    if (clips_every_point(c))
         return 0;
     zprim lpp;
     zprim_get(c->scene, c->rs, light, &lpp);

@@ -93,7 +93,7 @@ static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
 /* From this level on (E_2: light that has bounced twice) a group's members
  * take their leader's value instead of a cut of their own.  Light that
  * bounced twice varies little over h/8, and re-estimating a 640-cluster
- * cut at each member was most of that level's cost.  The engine room at
+ * cut at each member was a third of that level's cost.  The engine room at
  * depth 3, 512 x 512 (single runs): 45.0 s -> 41.6 s, 1.358% -> 1.379%
  * per pixel, 0.944% -> 0.960% over 4 x 4 blocks.  From E_1 on: 33.5 s,
  * 1.489% / 1.030%, where the first bounce bends within a group.  At E_2,
