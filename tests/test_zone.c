@@ -63,6 +63,43 @@ static const char *sky_box_text =
 
 static zt_scene *scene_from(const char *text) { return test_scene_text(text, "box.json"); }
 
+/* The box without its specular things, and three slats of a mesh near the
+ * floor: diffuse light of levels >= 2 on the slats is gathered (gather.c),
+ * which every rule below must keep. */
+static const char *mesh_box_text(void)
+{
+    static char text[4096];
+    if (text[0])
+        return text;
+    char obj[4096];
+    size_t len = (size_t)snprintf(obj, sizeof obj, "vn 0 -1 0\n");
+    for (int k = 0; k < 3; k++)
+        len = test_obj_sheet(obj, len, sizeof obj, 2, 1.0, -4.2 + 0.4 * k, 1 + 9 * k);
+    const char *path = test_write_file("slats.obj", obj);
+    snprintf(text, sizeof text,
+             "{\"scene\": ["
+             "{\"lighttriangle\": {\"points\": [[-1, 4.9, -1], [1, 4.9, -1], [-1, 4.9, 1]], "
+             "\"emission\": [8, 8, 7]}},"
+             "{\"lighttriangle\": {\"points\": [[1, 4.9, 1], [-1, 4.9, 1], [1, 4.9, -1]], "
+             "\"emission\": [6, 7, 8]}},"
+             "{\"thing\": {\"material\": " DIFFUSE(0.7, 0.7, 0.7) ", \"parts\": ["
+             "{\"triangle\": {\"points\": [[-5, -5, -5], [5, -5, 5], [5, -5, -5]]}},"
+             "{\"triangle\": {\"points\": [[-5, -5, -5], [-5, -5, 5], [5, -5, 5]]}},"
+             "{\"triangle\": {\"points\": [[-5, 5, -5], [5, 5, -5], [5, 5, 5]]}},"
+             "{\"triangle\": {\"points\": [[-5, 5, -5], [5, 5, 5], [-5, 5, 5]]}},"
+             "{\"triangle\": {\"points\": [[-5, -5, -5], [5, -5, -5], [5, 5, -5]]}},"
+             "{\"triangle\": {\"points\": [[-5, -5, -5], [5, 5, -5], [-5, 5, -5]]}}]}},"
+             "{\"thing\": {\"material\": " DIFFUSE(0.7, 0.15, 0.1) ", \"parts\": ["
+             "{\"triangle\": {\"points\": [[-5, -5, -5], [-5, 5, -5], [-5, 5, 5]]}},"
+             "{\"triangle\": {\"points\": [[-5, -5, -5], [-5, 5, 5], [-5, -5, 5]]}}]}},"
+             "{\"mesh\": {\"file\": \"%s\", \"smooth\": false, \"material\": "
+             DIFFUSE(0.6, 0.65, 0.7) "}}"
+             "], \"camera\": {\"viewpoint\": [0.3, 0.2, 14], \"screen\": [[-1, 1, 13], "
+             "[1, 1, 13], [-1, -1, 13], [1, -1, 13]], \"gridresolution\": [20, 16]}}",
+             path);
+    return text;
+}
+
 static zt_render_options zone_options(int depth, int threads)
 {
     zt_render_options o = zt_render_options_default();
@@ -172,14 +209,17 @@ static void test_strategies_identical(void **state)
     check_strategies(box_text, 3, -1);
     check_strategies(box_text, 2, 1);
     check_strategies(sky_box_text, 2, -1);
+    check_strategies(mesh_box_text(), 3, -1);
 }
 
-/* The per-zone terms add up to one zone_radiance call per sample. */
-static void check_terms(const char *text, int depth)
+/* The per-zone terms add up to one zone_radiance call per sample; the
+ * mesh's samples gather (or, with specular things about, do not). */
+static void check_terms(const char *text, int depth, int gathers)
 {
     zt_scene *s = scene_from(text);
     zt_render_options o = zone_options(depth, 2);
     zt_renderer *r = renderer(s, &o);
+    assert_int_equal(r->forest->mesh_gather, gathers);
     zt_image *terms = accumulate(r, s, NULL);
     zt_image *ref = zt_image_create(W, H);
     zt_error err = {0};
@@ -196,8 +236,9 @@ static void check_terms(const char *text, int depth)
 static void test_terms_sum_to_shading(void **state)
 {
     (void)state;
-    check_terms(box_text, 3);
-    check_terms(sky_box_text, 2);
+    check_terms(box_text, 3, 0);
+    check_terms(sky_box_text, 2, 0);
+    check_terms(mesh_box_text(), 3, 1);
 }
 
 /* The images of levels 0..o.depth, rendered one by one, add up to `all`
@@ -223,13 +264,16 @@ static void assert_levels_sum(const zt_scene *s, zt_render_options o, const zt_i
 static void test_levels_sum_to_depth(void **state)
 {
     (void)state;
-    zt_scene *s = scene_from(box_text);
-    const int depth = 3;
-    zt_render_options o = zone_options(depth, 2);
-    zt_image *all = render(s, &o, NULL);
-    assert_levels_sum(s, o, all, 1, "levels");
-    zt_image_release(all);
-    zt_scene_release(s);
+    const char *texts[2] = {box_text, mesh_box_text()};
+    for (int i = 0; i < 2; i++) {
+        zt_scene *s = scene_from(texts[i]);
+        const int depth = 3;
+        zt_render_options o = zone_options(depth, 2);
+        zt_image *all = render(s, &o, NULL);
+        assert_levels_sum(s, o, all, 1, i ? "levels, mesh box" : "levels");
+        zt_image_release(all);
+        zt_scene_release(s);
+    }
 }
 
 /* Two triangles piercing each other (an X seen end on) under a point light

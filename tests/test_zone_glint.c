@@ -72,7 +72,7 @@ static void test_image_matches_integral(void **state)
     o.threads = 1;
     zt_renderer *r = NULL;
     assert_int_equal(zt_renderer_create(s, &o, &r, &err), ZT_OK);
-    zone_trace t = {NULL, r, 0, 0};
+    zone_trace t = {.r = r};
     assert_true(glint_sphere(&r->rs, 1));
     const int mirror[1] = {1};
 

@@ -89,6 +89,8 @@ typedef struct zone_forest {
     sender_tree light_tree; /* the lights, when there are many */
     zone_quality q;
     int need_gather;    /* some light arrives by specular surfaces */
+    int mesh_gather;    /* camera samples on meshes gather their diffuse
+                           light of levels >= 2 (zone_gather_irradiance) */
     int sky;            /* the sky is not black: E_0 gathers it */
     int *glint_spheres; /* spheres that reflect lights as images (glint.h) */
     int glint_count;
@@ -133,6 +135,14 @@ void zone_forest_free(zone_forest *f);
 vec3 *zone_gather_directions(int n);
 
 /* Radiance arriving along a ray with levels lo..hi (flags below). */
+/* Where a camera sample's gathers take their directions (gather.c): its
+ * pixel's own stretch of one sequence, shared out among the pixel's
+ * samples of one grid. */
+typedef struct zone_gather_slot {
+    uint32_t pixel;         /* y * width + x */
+    uint16_t index, count;  /* the sample's place among them; 0, 0: none */
+} zone_gather_slot;
+
 typedef struct zone_trace {
     const zone_forest *f;
     const zt_renderer *r;
@@ -140,6 +150,7 @@ typedef struct zone_trace {
     /* Exact direct light at a camera sample that shares the fallback's
      * rays with its neighbours (direct_irradiance_split), 0: alone. */
     int light_split;
+    zone_gather_slot gather; /* the camera sample's (zone_gather_irradiance) */
 } zone_trace;
 
 /* Irradiance of level `level` at point x (normal n) on side `side` of
@@ -153,6 +164,18 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n);
  * there are many) at x (normal n) on primitive `receiver`, without the
  * sky's. */
 vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n);
+
+/* Whether a camera path's diffuse light of levels >= 2 at primitive prim
+ * is gathered (zone_gather_irradiance) rather than read from its nodes. */
+static inline int zone_gathers(const zone_forest *f, const rscene *rs, int prim)
+{
+    return f->mesh_gather && prim >= rs->part_count;
+}
+/* Irradiance of level `level` (>= 1) at x on a mesh (nf: the geometric
+ * normal on the side seen, n: the shading normal), gathered from the
+ * forest over cosine-weighted directions: the level's radiance where they
+ * meet the scene (phase_two/gather.c). */
+vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level);
 
 enum {
     ZR_EXACT_DIRECT = 1, /* level 1 from the analytic direct term, not maps */

@@ -235,6 +235,16 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
              o->weight[LOBE_REFRACTIVE] > 0))
             f->need_gather = 1;
     }
+    /* The gathers' rays see light by way of specular surfaces themselves,
+     * but not the caustic photons and glint images that the nodes hold:
+     * only where there are none. */
+    f->mesh_gather = !f->need_gather && f->glint_count == 0;
+    for (int i = 0; i < rs->object_count && f->mesh_gather; i++) {
+        const rs_object *o = &rs->objects[i];
+        if (!o->is_light && (o->weight[LOBE_METALLIC] > 0 || o->weight[LOBE_REFLECTING] > 0 ||
+                             o->weight[LOBE_REFRACTIVE] > 0))
+            f->mesh_gather = 0;
+    }
     f->sky = !f3_is_black(rs->sky);
     if (rs->light_count > ZONE_LIGHTS_EXACT && !sender_tree_build_lights(&f->light_tree, rs))
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the light tree");

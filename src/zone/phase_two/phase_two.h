@@ -13,7 +13,8 @@
  *   diffuse zone (q, level 1)         w_d rho/pi (sum of every light's exact
  *                                     E_direct(x), and the sky's) on samples
  *                                     whose first hit is q
- *   diffuse zone (q, level l >= 2)    w_d rho/pi E_{l-1}(x) from q's nodes
+ *   diffuse zone (q, level l >= 2)    w_d rho/pi E_{l-1}(x) from q's nodes,
+ *                                     or on a mesh gathered (gather.c)
  *   specular zone (q, kind, l >= 1)   the lobe's share of the level l-1
  *                                     radiance along the reflected (and, for
  *                                     glass, refracted) ray
@@ -48,6 +49,7 @@ typedef struct p2_sample {
     int surface;    /* its surface (zone_surface_of), -1: nothing */
     int light_split; /* its share of the direct light's rays (zone_trace) */
     double w;       /* weight in the pixel (the weights of a pixel sum to 1) */
+    zone_gather_slot gather; /* its gathers' directions (zone_trace) */
 } p2_sample;
 
 /* The sample lists of one row of pixels. */

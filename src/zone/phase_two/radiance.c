@@ -2,7 +2,8 @@
  *   level 0      lights (and sky) seen directly;
  *   level 1      diffuse: rho/pi * exact direct irradiance (camera paths) or
  *                the level-0 map (gathers);
- *   level l >= 2 diffuse: rho/pi * the level l-1 irradiance map;
+ *   level l >= 2 diffuse: rho/pi * the level l-1 irradiance map, or on a
+ *                mesh (camera paths) the level l-1 light gathered there;
  *   specular lobes (mirror, metal, glass) pass the levels below theirs on
  *   along the reflected and refracted rays, deterministically: the glass
  *   lobe follows both the reflected and the transmitted ray. */
@@ -68,6 +69,8 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                 e = v3_add(e, zone_lights_at(t, h.part, x, n));
                 if (t->f->sky)
                     e = v3_add(e, zone_sky_irradiance(t, x, n));
+            } else if (exact_direct && zone_gathers(t->f, rs, h.part)) {
+                e = v3_add(e, zone_gather_irradiance(t, xf, nf, n, l - 1));
             } else {
                 e = v3_add(e, zone_map_read(t->f, rs, l - 1, h.part, back, x));
             }

@@ -92,7 +92,7 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
     volatile int failed = 0; /* set by any thread that runs out of memory */
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
-        zone_trace t = {c->f, c->r, 0, 0};
+        zone_trace t = {.f = c->f, .r = c->r};
         p2_row row;
         memset(&row, 0, sizeof row);
         int *list = NULL, cap = 0;
@@ -139,7 +139,7 @@ zt_status p2_render_reference(const p2_ctx *c, zt_image *sum, uint64_t *rays_out
     volatile int failed = 0; /* set by any thread that runs out of memory */
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
-        zone_trace t = {c->f, c->r, 0, 0};
+        zone_trace t = {.f = c->f, .r = c->r};
         p2_row row;
         memset(&row, 0, sizeof row);
 #pragma omp for schedule(dynamic, 1)
@@ -291,7 +291,7 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
         /* Small terms stay on this thread: waking the others costs more. */
 #pragma omp parallel num_threads(threads) reduction(+ : rays) if (n >= 256)
         {
-            zone_trace t = {c->f, c->r, 0, 0};
+            zone_trace t = {.f = c->f, .r = c->r};
             int done = 0;
 #pragma omp for schedule(dynamic, 16)
             for (int i = 0; i < n; i++) {

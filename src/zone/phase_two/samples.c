@@ -169,8 +169,15 @@ static void note_light(const rscene *rs, seen_lights *s, int part)
     }
 }
 
+static zone_gather_slot gather_slot(const p2_ctx *c, int px, int py, int index, int count)
+{
+    zone_gather_slot g = {(uint32_t)py * (uint32_t)c->c.width + (uint32_t)px, (uint16_t)index,
+                          (uint16_t)count};
+    return g;
+}
+
 static int push_sample(const rscene *rs_of_row, p2_row *row, vec3f o, vec3f d, hit h, double w,
-                       int light_split)
+                       int light_split, zone_gather_slot gather)
 {
     if (row->sample_count == row->sample_capacity) {
         size_t cap = row->sample_capacity ? 2 * row->sample_capacity : 1024;
@@ -181,7 +188,7 @@ static int push_sample(const rscene *rs_of_row, p2_row *row, vec3f o, vec3f d, h
         row->sample_capacity = cap;
     }
     p2_sample s = {o, d, h.t, h.part, h.part < 0 ? -1 : zone_surface_of(rs_of_row, h.part),
-                   light_split, w};
+                   light_split, w, gather};
     row->samples[row->sample_count++] = s;
     return 1;
 }
@@ -226,7 +233,9 @@ static int grid_samples(const p2_ctx *c, int px, int py, int g, int split, uint3
                 *edge = 1;
             note_light(rs, lights, h.part);
             int ls = split ? 1 + (sx & 1) + 2 * (sy & 1) : 0;
-            if (!*edge && !push_sample(rs, row, org, dir, h, 1.0 / (g * g), ls))
+            if (!*edge &&
+                !push_sample(rs, row, org, dir, h, 1.0 / (g * g), ls,
+                             gather_slot(c, px, py, sy * g + sx, g * g)))
                 return 0;
         }
     return 1;
@@ -324,7 +333,7 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
         cover_point(quasi, n, i, &u, &v);
         cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
         double w = (double)e->group_count[k] / ((double)e->group_shaded[k] * cells);
-        if (!push_sample(rs, row, org, dir, e->hits[i], w, 0))
+        if (!push_sample(rs, row, org, dir, e->hits[i], w, 0, gather_slot(c, px, py, 0, 1)))
             return 0;
     }
     /* Surfaces too small to meet the subset: the point nearest their
@@ -356,7 +365,8 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
         }
         cover_point(quasi, n, best, &u, &v);
         cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
-        if (!push_sample(rs, row, org, dir, e->hits[best], (double)e->group_count[k] / cells, 0))
+        if (!push_sample(rs, row, org, dir, e->hits[best], (double)e->group_count[k] / cells, 0,
+                         gather_slot(c, px, py, 0, 1)))
             return 0;
     }
     return 1;

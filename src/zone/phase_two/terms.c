@@ -159,12 +159,15 @@ static vec3 direct_value(zone_trace *t, const p2_sample *s)
     return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
 }
 
-/* Level l >= 2 diffuse light from the surface's nodes E_{l-1}. */
+/* Level l >= 2 diffuse light from the surface's nodes E_{l-1}, or on a
+ * mesh gathered. */
 static vec3 map_value(zone_trace *t, const p2_term *term, const p2_sample *s)
 {
     surface sf;
     surface_of(&t->r->rs, s, &sf);
-    vec3 e = zone_map_read(t->f, &t->r->rs, term->level - 1, s->part, sf.back, sf.x);
+    vec3 e = zone_gathers(t->f, &t->r->rs, s->part)
+                 ? zone_gather_irradiance(t, sf.xf, sf.nf, sf.n, term->level - 1)
+                 : zone_map_read(t->f, &t->r->rs, term->level - 1, s->part, sf.back, sf.x);
     return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
 }
 
@@ -288,6 +291,7 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
         if (s->surface != term->part)
             continue;
         t->light_split = s->light_split;
+        t->gather = s->gather;
         vec3 v;
         switch (term->type) {
         case P2_EMIT: {
@@ -303,6 +307,7 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
         add(acc, s->w, v);
     }
     t->light_split = 0;
+    t->gather = (zone_gather_slot){0, 0, 0};
 }
 
 void p2_reference(const p2_ctx *c, zone_trace *t, const p2_pixel *px, double acc[3])
@@ -314,8 +319,10 @@ void p2_reference(const p2_ctx *c, zone_trace *t, const p2_pixel *px, double acc
                 add(acc, 1.0, root_value(c, t, i, px));
     for (int i = 0; i < px->n; i++) {
         t->light_split = px->s[i].light_split;
+        t->gather = px->s[i].gather;
         add(acc, px->s[i].w,
             zone_radiance(t, px->s[i].o, px->s[i].d, c->lo, c->hi, SHADE_FLAGS, NULL, 0));
     }
     t->light_split = 0;
+    t->gather = (zone_gather_slot){0, 0, 0};
 }
