@@ -105,11 +105,12 @@ static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
  * mesh's nodes are read only by the gathers' rays and as senders, which
  * average many of them: a receiver on a mesh opens a quarter of the
  * level's limit.  The engine room at depth 3, 512 x 512 (whole job, single
- * runs): x 5/4 (as without gathers) 20.3 s for 0.923% per pixel and 0.552%
- * over 4 x 4 blocks, x 1/4 15.7 s for 0.927% / 0.567%, x 1/8 13.8 s for
- * 1.093% / 0.786% (a cut at its limit leaves the floor 0.35% short).
- * Members of a group taking their leader's value from E_1 on as well:
- * 0.8 s less for 0.935% / 0.574%. */
+ * runs, before the gathers' per-pixel directions): x 5/4 (as without
+ * gathers) about 37 s for 0.916% per pixel and 0.558% over 4 x 4 blocks,
+ * x 1/2 20.3 s for 0.923% / 0.552%, x 1/4 15.7 s for 0.927% / 0.567%, x 1/8
+ * 13.8 s for 1.093% / 0.786% (cuts at their limit leave the floor 0.35%
+ * short).  Members of a group taking their leader's value from E_1 on as
+ * well: 0.8 s less for 0.935% / 0.574%. */
 #define GATHERED_MESH_CUT_DIV 4
 
 static vec3 node_point(const surface_nodes *sn, int32_t k, vec3 *n)

@@ -9,25 +9,26 @@
  * integrated over the hemisphere, and the nodes' error is averaged over
  * the many nodes the rays meet.  The rays follow one fixed sequence (Roberts'
  * R2, cosine-weighted), and a pixel's samples take interleaved points of
- * it: sample i of n takes points i, i + n, i + 2n, ..., so that the pixel
- * as a whole integrates GATHER_PIXEL directions evenly spread.  The image
- * stays deterministic; its error is the quadrature's, which the pixel's
- * samples share out.
+ * it: each pixel its own stretch, and sample i of n takes points i, i + n,
+ * i + 2n, ... of it, so that the pixel as a whole integrates its
+ * directions evenly spread.  The image stays deterministic; its error is
+ * the quadrature's, which changes from pixel to pixel.
  *
  * The engine room at 512 x 512, depth 3 (docs/zone-tracer.md,
  * BENCHMARKS.md): reading the nodes 1.385% per pixel against the path
- * reference; gathering levels 2 and 3, 0.94%, and the mesh's nodes can take
- * a quarter of the cut limit (they are only read through the gathers). */
+ * reference in 37 s; gathering levels 2 and 3, 0.894% in 16.8 s, since the
+ * mesh's nodes can then take a quarter of the cut limit (phase_one.c). */
 #include <math.h>
 
 #include "geom/ray_offset.h"
 #include "util/vec3_convert.h"
 #include "zone/zone.h"
 
-/* Directions a pixel's gathering samples share, at least one each.  On the
- * engine room 16 directions per smooth pixel gave 1.036% per pixel, 64
- * 1.032%; 1, 2, 4 directions per sample of a detail pixel's 64 gave
- * 1.099%, 1.059%, 1.036% (level 2 only, for 0.14, 0.36 and 1.1 s). */
+/* Directions a pixel's gathering samples share, and at least GATHER_MIN
+ * each (a mesh-detail pixel's 64 samples: 128).  On the engine room (one
+ * saved forest): 16 a pixel and 1 each 0.981% per pixel, 32 0.953%, 64
+ * 0.949%; 32 and 2 each 0.894% for 0.6 s more of Phase Two; 128 (2 each)
+ * 0.880% and 256 (4 each) 0.840% for 1.7 s and 4.6 s more. */
 #define GATHER_PIXEL 32
 #define GATHER_MIN 2
 
