@@ -293,6 +293,25 @@ static void test_sphere_in_white_sky(void **state)
     zt_scene_release(s);
 }
 
+#define FURNACE_A 0.5   /* the wall's albedo */
+#define FURNACE_R 10.0  /* the sphere's radius */
+#define FURNACE_I 100.0 /* the point light's intensity */
+
+/* The closed sphere of the furnaces below (facing in), seen from near its
+ * centre, with the point light at (0, 0, light_z). */
+static zt_scene *closed_sphere_scene(double light_z, const char *name)
+{
+    const char *obj = write_sphere_obj("furnace_in.obj", 64, 32, FURNACE_R, v3(0, 0, 0), 1);
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"camera\": {\"position\": [0, 0, 0.5], \"lookat\": [0, 0, 5], \"fov\": 20, "
+             "\"gridresolution\": [16, 16]}, \"scene\": [{\"lightpoint\": {\"point\": [0, 0, %g], "
+             "\"emission\": [%g, %g, %g]}}, {\"mesh\": {\"file\": \"%s\", \"smooth\": false, "
+             "" TEST_DIFFUSE_FMT "}}]}",
+             light_z, FURNACE_I, FURNACE_I, FURNACE_I, obj, FURNACE_A, FURNACE_A, FURNACE_A);
+    return test_scene_text(text, name);
+}
+
 /* Inside a closed mesh sphere (facing in) of albedo a, a point light of
  * power P at the centre: every bounce lands uniformly on the sphere, so the
  * irradiance is E0 (1 + a + a^2 + ...) = E0 / (1 - a), E0 = P / (4 pi R^2),
@@ -302,16 +321,8 @@ static void test_sphere_in_white_sky(void **state)
 static void test_closed_sphere_furnace(void **state)
 {
     (void)state;
-    const double a = 0.5, R = 10, I = 100; /* I: the point light's intensity */
-    const char *obj = write_sphere_obj("furnace_in.obj", 64, 32, R, v3(0, 0, 0), 1);
-    char text[2048];
-    snprintf(text, sizeof text,
-             "{\"camera\": {\"position\": [0, 0, 0.5], \"lookat\": [0, 0, 5], \"fov\": 20, "
-             "\"gridresolution\": [16, 16]}, \"scene\": [{\"lightpoint\": {\"point\": [0, 0, 0], "
-             "\"emission\": [%g, %g, %g]}}, {\"mesh\": {\"file\": \"%s\", \"smooth\": false, "
-             "" TEST_DIFFUSE(0.5) "}}]}",
-             I, I, I, obj);
-    zt_scene *s = test_scene_text(text, "furnace_in.json");
+    const double a = FURNACE_A, R = FURNACE_R, I = FURNACE_I;
+    zt_scene *s = closed_sphere_scene(0, "furnace_in.json");
     zt_render_options o = path_options(512, 4);
     o.depth = 64; /* a^64: nothing left */
     zt_image *img = render(s, &o);
@@ -338,16 +349,8 @@ static void test_closed_sphere_furnace(void **state)
 static void test_closed_sphere_first_bounce_zone(void **state)
 {
     (void)state;
-    const double a = 0.5, R = 10, I = 100;
-    const char *obj = write_sphere_obj("furnace_in.obj", 64, 32, R, v3(0, 0, 0), 1);
-    char text[2048];
-    snprintf(text, sizeof text,
-             "{\"camera\": {\"position\": [0, 0, 0.5], \"lookat\": [0, 0, 5], \"fov\": 20, "
-             "\"gridresolution\": [16, 16]}, \"scene\": [{\"lightpoint\": {\"point\": [0, 0, -5], "
-             "\"emission\": [%g, %g, %g]}}, {\"mesh\": {\"file\": \"%s\", \"smooth\": false, "
-             "" TEST_DIFFUSE(0.5) "}}]}",
-             I, I, I, obj);
-    zt_scene *s = test_scene_text(text, "furnace_off_centre.json");
+    const double a = FURNACE_A, R = FURNACE_R, I = FURNACE_I;
+    zt_scene *s = closed_sphere_scene(-5, "furnace_off_centre.json");
     zt_render_options o = zt_render_options_default();
     o.method = ZT_METHOD_ZONE;
     o.threads = 2;
