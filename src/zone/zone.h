@@ -75,9 +75,9 @@ typedef struct zone_quality {
     int probe;          /* signatures per side that look for an edge in a
                            pixel (no more than aa: the samples' own) */
     int photons;        /* caustic photons per light (caustic.h) */
-    int mesh_gather;    /* directions a pixel's samples on a mesh share
-                           (gather.c) */
-    int mesh_gather_min; /* and that each of them takes at least */
+    int mesh_gather_pixel;  /* directions a pixel's samples on a mesh
+                               share (gather.c) */
+    int mesh_gather_sample; /* and that each of them takes at least */
 } zone_quality;
 
 typedef struct zone_forest {

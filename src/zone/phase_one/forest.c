@@ -161,8 +161,8 @@ zone_quality zone_quality_for(const zt_scene *sc, const rscene *rs, int q)
      * are a sixth of the engine room's Phase Two) and make the image
      * noisy. */
     int qg = q < 2 ? 0 : q > 10 ? 8 : q - 2;
-    z.mesh_gather = 32 << qg;
-    z.mesh_gather_min = 2 << qg / 2;
+    z.mesh_gather_pixel = 32 << qg;
+    z.mesh_gather_sample = 2 << qg / 2;
     return z;
 }
 

@@ -38,14 +38,15 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
 {
     int count = t->gather.count > 1 ? t->gather.count : 1;
     int index = t->gather.count > 1 ? t->gather.index : 0;
-    /* The pixel's directions (q.mesh_gather), at least q.mesh_gather_min
-     * a sample.  On the engine room at quality 2 (one saved forest): 16 a
-     * pixel and 1 each 0.981% per pixel, 32 0.953%, 64 0.949%; 32 and 2
-     * each (the quality's: a mesh-detail pixel's 64 samples take 128)
-     * 0.894% for 0.6 s more of Phase Two; 128 (2 each) 0.880% and 256 (4
-     * each) 0.840% for 1.7 s and 4.6 s more. */
-    int per_sample = t->f->q.mesh_gather / count;
-    int k_max = per_sample > t->f->q.mesh_gather_min ? per_sample : t->f->q.mesh_gather_min;
+    /* The pixel's directions (q.mesh_gather_pixel), at least
+     * q.mesh_gather_sample a sample.  On the engine room at quality 2 (one
+     * saved forest): 16 a pixel and 1 each 0.981% per pixel, 32 0.953%, 64
+     * 0.949%; 32 and 2 each (the quality's: a mesh-detail pixel's 64
+     * samples take 128) 0.894% for 0.6 s more of Phase Two; 128 (2 each)
+     * 0.880% and 256 (4 each) 0.840% for 1.7 s and 4.6 s more. */
+    const zone_quality *q = &t->f->q;
+    int per_sample = q->mesh_gather_pixel / count;
+    int k_max = per_sample > q->mesh_gather_sample ? per_sample : q->mesh_gather_sample;
     /* The pixel's stretch of the sequence: neighbours take different
      * directions, so that the quadrature's error changes from pixel to
      * pixel rather than biasing a whole region alike, and a region's mean
