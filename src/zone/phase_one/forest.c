@@ -245,8 +245,9 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
     }
     /* The gathers' rays see light by way of specular surfaces themselves,
      * but not the caustic photons and glint images that the nodes hold:
-     * only where there are none. */
-    f->mesh_gather = !f->need_gather && f->glint_count == 0;
+     * only where there are none (no specular lobe anywhere, so no glint
+     * spheres either). */
+    f->mesh_gather = 1;
     for (int i = 0; i < rs->object_count && f->mesh_gather; i++) {
         const rs_object *o = &rs->objects[i];
         if (!o->is_light && (o->weight[LOBE_METALLIC] > 0 || o->weight[LOBE_REFLECTING] > 0 ||

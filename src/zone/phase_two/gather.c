@@ -18,21 +18,12 @@
  * BENCHMARKS.md): reading the nodes 1.385% per pixel against the path
  * reference in 37 s; gathering levels 2 and 3, 0.894% in 16.8 s, since the
  * mesh's nodes can then take a quarter of the cut limit (phase_one.c). */
-#include <math.h>
 
 #include "geom/ray_offset.h"
+#include "material/bsdf.h"
+#include "util/r2.h"
 #include "util/vec3_convert.h"
 #include "zone/zone.h"
-
-
-/* Point j of the R2 sequence, in [0, 1)^2. */
-static void r2_point(double j, double *u, double *v)
-{
-    const double a1 = 0.75487766624669276005; /* 1 / g, g^3 = g + 1 */
-    const double a2 = 0.56984029099805326591; /* 1 / g^2 */
-    *u = fmod(0.5 + a1 * j, 1.0);
-    *v = fmod(0.5 + a2 * j, 1.0);
-}
 
 vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
 {
@@ -52,8 +43,9 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
      * pixel rather than biasing a whole region alike, and a region's mean
      * converges as one long sequence. */
     double first = (double)t->gather.pixel * count * k_max + index + 1;
-    vec3 tt, bb, nfd = f3_to_v3(nf);
+    vec3 tt, bb;
     v3_frame(n, &tt, &bb);
+    shading_frame frame = {v3_to_f3(tt), v3_to_f3(bb), v3_to_f3(n)};
     vec3f o = ray_offset(x, nf);
     /* The gathered rays see level-1 light from the nodes (no exact direct
      * light at their hits: the integral smooths what the nodes blur). */
@@ -63,14 +55,13 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
     for (int k = 0; k < k_max; k++) {
         double u, v;
         r2_point(first + (double)count * k, &u, &v);
-        double r = sqrt(u), phi = 6.28318530717958648 * v;
-        vec3 d = v3_add(v3_add(v3_scale(tt, r * cos(phi)), v3_scale(bb, r * sin(phi))),
-                        v3_scale(n, sqrt(1.0 - u)));
+        const float uv[2] = {(float)u, (float)v};
+        vec3f d = bsdf_cosine_hemisphere(&frame, uv);
         /* Below the geometric surface (a shading normal tilts the frame):
          * no light from there. */
-        if (v3_dot(d, nfd) <= 0)
+        if (f3_dot(d, nf) <= 0.0f)
             continue;
-        sum = v3_add(sum, zone_radiance(t, o, v3_to_f3(v3_normalize(d)), level, level,
+        sum = v3_add(sum, zone_radiance(t, o, f3_normalize(d), level, level,
                                         ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0));
     }
     t->light_split = save;

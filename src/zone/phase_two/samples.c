@@ -23,6 +23,7 @@
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
 #include "render/prim.h"
+#include "util/r2.h"
 #include "util/vec3_convert.h"
 #include "zone/light/direct.h"
 #include "zone/phase_two/media.h"
@@ -250,16 +251,15 @@ typedef struct edge_grid {
 } edge_grid;
 
 /* Point i of an edge pixel's n x n coverage points, in [0, 1)^2: the
- * centre of cell i, or the i-th point of Roberts' R2 sequence (additive
- * recurrence on the plastic number), whose every prefix is spread evenly
- * and which lines up with no edge direction. */
+ * centre of cell i, or the i-th point of Roberts' R2 sequence, which lines
+ * up with no edge direction. */
 static void cover_point(int quasi, int n, int i, float *u, float *v)
 {
     if (quasi) {
-        const double g = 1.32471795724474602596; /* x^3 = x + 1 */
-        double a = 0.5 + i / g, b = 0.5 + i / (g * g);
-        *u = (float)(a - floor(a));
-        *v = (float)(b - floor(b));
+        double a, b;
+        r2_point(i, &a, &b);
+        *u = (float)a;
+        *v = (float)b;
     } else {
         *u = (i % n + 0.5f) / n;
         *v = (i / n + 0.5f) / n;
