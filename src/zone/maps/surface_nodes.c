@@ -27,11 +27,11 @@
  * send its light, from its corners alone.  On the engine room at depth 3
  * this takes the error over 4 x 4 blocks from 1.36% to 1.06% for about 15%
  * more time (only the triangles with a corner on a crease: 1.14%).  A
- * smooth sphere of a few hundred triangles gains nothing and its Phase One
- * takes up to 2.3 times as long (BENCHMARKS.md).  Triangles written in the
- * scene file keep h: their edge nodes sit a quarter cell inside, and half
- * the spacing made the shipped scenes no better (triangletest 0.65% ->
- * 0.83%) for up to 3.7 times the Phase One. */
+ * smooth sphere of a few hundred triangles gains nothing and its Phase
+ * One takes up to 2.3 times as long (the N-series at N = 840).  Triangles
+ * written in the scene file keep h: their edge nodes sit a quarter cell
+ * inside, and half the spacing made the shipped scenes no better
+ * (triangletest 0.65% -> 0.83%) for up to 3.7 times the Phase One. */
 #define MODEL_SPACING 0.5
 
 static int tri_total(int n) { return (n + 1) * (n + 2) / 2; }
