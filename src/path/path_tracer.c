@@ -3,12 +3,18 @@
  *   L += beta * f * cos * Li / p_light * w_light (next-event estimation)
  *   beta *= f * cos / p_bsdf                     (continue the path)
  * with w the power-heuristic MIS weights, and levels counted as the number
- * of scattering events before the light reaches the eye. */
+ * of scattering events before the light reaches the eye.  Light from far
+ * away (sun, environment map) is a second light of the same form: one more
+ * next-event sample (distant.h's mixture) and its own MIS weight on the rays
+ * that escape. */
 #include "path/path_tracer.h"
+
+#include <float.h>
 
 #include "geom/accel.h"
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
+#include "light/distant.h"
 #include "light/light_sample.h"
 #include "material/bsdf.h"
 #include "render/prim.h"
@@ -22,7 +28,10 @@
 /* Vertices after the first carry less of the image and use the plain
  * stream: stratifying them measurably costs more than it gains. */
 #define STRATIFIED_VERTICES 1
-_Static_assert(1 + STRATIFIED_VERTICES * PAIRS_PER_VERTEX == PATH_SEEDED_PAIRS,
+/* The first vertex's direction toward light from far away: the last pair,
+ * so that the pairs before it keep their seeds. */
+#define DISTANT_PAIR (1 + STRATIFIED_VERTICES * PAIRS_PER_VERTEX)
+_Static_assert(DISTANT_PAIR + 1 == PATH_SEEDED_PAIRS,
                "the pixel holds the seed of every stratified pair");
 
 static inline float power_heuristic(float a, float b)
@@ -79,8 +88,17 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         n_rays++;
         int counted = k >= pp->min_level;
         if (h.part < 0) {
-            if (counted)
-                radiance = f3_add(radiance, f3_mul(beta, rs->sky));
+            if (counted) {
+                vec3f le = rs->sky;
+                if (rs->distant.any) {
+                    vec3f ld = distant_radiance(&rs->distant, d);
+                    if (!prev_delta && !f3_is_black(ld))
+                        ld = f3_scale(ld, power_heuristic(prev_pdf,
+                                                          distant_pdf(&rs->distant, d)));
+                    le = f3_add(le, ld);
+                }
+                radiance = f3_add(radiance, f3_mul(beta, le));
+            }
             break;
         }
         rs_part tri;
@@ -161,6 +179,31 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                                                 : power_heuristic_over(ls.pdf, bsdf_pdf);
                     radiance = f3_add(radiance,
                                       f3_scale(f3_mul(f3_mul(beta, fcos), ls.li), w_over_pdf));
+                }
+            }
+        }
+
+        /* Next-event estimation of light from far away. */
+        if (nee && rs->distant.any) {
+            float u_far[2], u_pick = rs->distant.map && rs->distant.sun ? sampler_next(&rng) : 0.0f;
+            if (k <= STRATIFIED_VERTICES) {
+                sampler_get2_seeded(px->pair_seed[DISTANT_PAIR], rev_index, u_far);
+            } else {
+                u_far[0] = sampler_next(&rng);
+                u_far[1] = sampler_next(&rng);
+            }
+            vec3f wi, li;
+            float far_pdf, bsdf_pdf;
+            if (distant_sample(&rs->distant, u_pick, u_far, &wi, &far_pdf, &li) &&
+                (!bent || f3_dot(n, wi) > 0.0f)) {
+                vec3f fcos = bsdf_eval_diffuse(m, ns, wi, &bsdf_pdf);
+                if (bsdf_pdf > 0.0f && !f3_is_black(li)) {
+                    n_rays++;
+                    /* Escaping means meeting nothing, background included. */
+                    if (!accel_occluded(rs, x_out, wi, FLT_MAX, 1))
+                        radiance = f3_add(radiance,
+                                          f3_scale(f3_mul(f3_mul(beta, fcos), li),
+                                                   power_heuristic_over(far_pdf, bsdf_pdf)));
                 }
             }
         }

@@ -14,8 +14,9 @@ typedef struct path_params {
 } path_params;
 
 /* The dimension pairs every sample draws from the stratified sampler: the
- * pixel position, then the first vertex's light point and direction. */
-#define PATH_SEEDED_PAIRS 3
+ * pixel position, then the first vertex's light point and direction, and
+ * its direction toward light from far away (sun, environment map). */
+#define PATH_SEEDED_PAIRS 4
 
 /* A pixel's sampler key and the scramble seeds of those pairs
  * (sampler_pair_seed), which are the same for all its samples. */

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "geom/accel.h"
+#include "light/distant.h"
 #include "render/prim.h"
 #include "scene/mesh.h"
 #include "util/error.h"
@@ -177,6 +178,7 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     }
     rs->sky = v3_to_f3(scene->sky);
+    distant_build(&rs->distant, scene);
 
     for (int i = 0; i < scene->object_count; i++) {
         const object *o = &scene->objects[i];

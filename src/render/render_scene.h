@@ -79,6 +79,26 @@ typedef struct rs_planes {
     int *part;
 } rs_planes;
 
+/* Light from far away besides the constant sky: an environment map and the
+ * sun (light/distant.h evaluates and samples them). */
+struct env_map;
+typedef struct rs_distant {
+    int any;              /* a map or a sun */
+    const struct env_map *map; /* NULL: none (the scene holds the reference) */
+    const struct env_map *sampling; /* the distribution drawn from: the map
+                                       itself (a test may swap in another of
+                                       the same size to compare) */
+    float strength;
+    float rot_cos, rot_sin; /* the map's turn about +y */
+    int sun;              /* a sun is present */
+    vec3f sun_dir, sun_t, sun_b; /* toward the sun, and a frame around it */
+    float sun_one_minus_cos; /* 1 - cos of the disc's angular radius */
+    float sun_sin2;       /* sin^2 of the angular radius */
+    vec3f sun_radiance;   /* irradiance / (pi sin^2 radius) */
+    float sun_select;     /* next-event estimation's chance of the sun
+                             (against the map) */
+} rs_distant;
+
 typedef struct rscene {
     rs_part *parts;
     int part_count;
@@ -96,6 +116,7 @@ typedef struct rscene {
      * against every ray. */
     rs_planes planes[2];
     vec3f sky;
+    rs_distant distant;
     float light_power;  /* total of the sampled lights' power (select_pdf's
                            denominator) */
     struct accel *accel;

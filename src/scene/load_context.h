@@ -9,16 +9,6 @@
 #include "scene/scene.h"
 #include "scene/source_map.h"
 
-typedef struct load_ctx {
-    const char *name;             /* file name for messages */
-    const char *dir;              /* the folder model files are relative to
-                                     ("" for the current one) */
-    const source_map *map;
-    const json_positions *positions;
-    zt_error *err;
-    zt_scene *scene;              /* being built */
-} load_ctx;
-
 /* A value and where it sits: a member of an object (key != NULL), an
  * element of an array, or the document's root (parent == NULL). */
 typedef struct jref {
@@ -27,6 +17,27 @@ typedef struct jref {
     const char *key;
     size_t index;
 } jref;
+
+/* A sky model waits for the end of the scene list, where the sun it
+ * follows is known (load_daylight_finish). */
+typedef struct sky_model_request {
+    int pending;
+    double turbidity;
+    int has_sun;                  /* its own sun position, in sun */
+    vec3 sun;
+    jref where;                   /* the "model" value, for messages */
+} sky_model_request;
+
+typedef struct load_ctx {
+    const char *name;             /* file name for messages */
+    const char *dir;              /* the folder model files are relative to
+                                     ("" for the current one) */
+    const source_map *map;
+    const json_positions *positions;
+    zt_error *err;
+    zt_scene *scene;              /* being built */
+    sky_model_request sky_model;
+} load_ctx;
 
 jref jref_root(const json_t *root);
 jref jref_member(const json_t *obj, const char *key);

@@ -1,5 +1,6 @@
 /* The "scene" list: standalone primitives (one object each), thing and
- * light groups (one object with several parts) and the sky. */
+ * light groups (one object with several parts); the sky and the sun are
+ * load_daylight.c's. */
 #include "scene/scene_reader.h"
 
 #include <string.h>
@@ -176,20 +177,6 @@ static zt_status load_group(load_ctx *ctx, jref body, int is_light, int line)
     return ZT_OK;
 }
 
-static zt_status load_sky(load_ctx *ctx, jref item, jref body)
-{
-    static const char *const keys[] = {"color", NULL};
-    if (ctx->scene->has_sky)
-        return load_fail(ctx, item, "a second sky: only one is allowed");
-    if (load_object(ctx, body, "sky") ||
-        load_known_keys(ctx, body, "sky", keys) ||
-        load_require(ctx, body, "color", "sky") ||
-        load_radiance(ctx, jref_member(body.value, "color"), &ctx->scene->sky))
-        return ZT_ERR_PARSE;
-    ctx->scene->has_sky = 1;
-    return ZT_OK;
-}
-
 static zt_status load_item(load_ctx *ctx, jref item)
 {
     if (!json_is_object(item.value))
@@ -212,6 +199,8 @@ static zt_status load_item(load_ctx *ctx, jref item)
     int line = load_line(ctx, item);
     if (strcmp(key, "sky") == 0)
         return load_sky(ctx, item, body);
+    if (strcmp(key, "sun") == 0)
+        return load_sun(ctx, item, body);
     if (strcmp(key, "thing") == 0 || strcmp(key, "light") == 0)
         return load_group(ctx, body, key[0] == 'l', line);
     if (strcmp(key, "mesh") == 0)

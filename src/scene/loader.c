@@ -53,7 +53,7 @@ static zt_status load_top_level(load_ctx *ctx, const json_t *root)
         return load_fail(ctx, top, "missing \"scene\" at the top level");
     if (!json_object_get(root, "camera"))
         return load_fail(ctx, top, "missing \"camera\" at the top level");
-    return ZT_OK;
+    return load_daylight_finish(ctx);
 }
 
 /* The stages after the rewrite.  *scene is built in place. */
@@ -64,7 +64,7 @@ static zt_status load_parsed(const char *name, const char *dir, const char *orig
     source_map map;
     if (!source_map_init(&map, original, length, strict))
         return zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", name);
-    load_ctx ctx = {name, dir, &map, NULL, err, scene};
+    load_ctx ctx = {name, dir, &map, NULL, err, scene, {0}};
     json_error_t jerr;
     json_t *root = json_loadb(strict->text, strict->length,
                               JSON_REJECT_DUPLICATES | JSON_DECODE_ANY, &jerr);

@@ -290,7 +290,7 @@ zt_status zt_motions_load_string(const char *text, size_t length,
         free(copy);
         return zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", name);
     }
-    load_ctx ctx = {name, "", &map, NULL, err, NULL};
+    load_ctx ctx = {name, "", &map, NULL, err, NULL, {0}};
     zt_status status;
     zt_motions *ms = NULL;
     const char *nul = memchr(copy, '\0', length);

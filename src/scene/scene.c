@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "light/env_map.h"
 #include "scene/mesh.h"
 #include "util/error.h"
 
@@ -22,6 +23,7 @@ void zt_scene_release(zt_scene *scene)
     for (int i = 0; i < scene->mesh_count; i++)
         mesh_release(scene->meshes[i]);
     free(scene->meshes);
+    env_map_release(scene->sky_map);
     free(scene);
 }
 
@@ -111,6 +113,8 @@ zt_scene *zt_scene_clone(const zt_scene *scene)
     c->object_capacity = scene->object_count;
     c->part_capacity = scene->part_count;
     c->mesh_capacity = scene->mesh_count;
+    if (scene->sky_map)
+        env_map_retain(scene->sky_map);
     if (scene->object_count) {
         c->objects = malloc((size_t)scene->object_count * sizeof(object));
         if (c->objects)

@@ -56,6 +56,15 @@ typedef struct object {
 } object;
 
 struct mesh;
+struct env_map;
+
+/* The sun: a disc of directions of uniform radiance, far away. */
+typedef struct sun_light {
+    int present;
+    vec3 direction;  /* unit, toward the sun */
+    vec3 irradiance; /* on a surface facing the sun, per channel */
+    double angle;    /* angular diameter in radians, > 0 */
+} sun_light;
 
 struct zt_scene {
     object *objects;
@@ -66,7 +75,14 @@ struct zt_scene {
     int mesh_count, mesh_capacity;
     int light_count, thing_count;
     vec3 sky;        /* constant radiance of the background, black by default */
-    int has_sky;
+    int has_sky;     /* the file has a sky item (a colour or a map) */
+    /* Light from far away besides the constant sky: an environment map (from
+     * a file or a sky model; shared with copies of the scene), times
+     * sky_strength, turned by sky_rotate radians about +y; and the sun. */
+    struct env_map *sky_map;
+    double sky_strength;
+    double sky_rotate;
+    sun_light sun;
     int has_camera;
     zt_camera camera;
 };

@@ -2,6 +2,7 @@
  * the camera. */
 #include "scene/scene_hash.h"
 
+#include "light/env_map.h"
 #include "scene/mesh.h"
 #include "util/fnv1a.h"
 
@@ -76,5 +77,20 @@ uint64_t scene_hash(const zt_scene *sc)
     }
     fnv_v3(&h, sc->sky);
     fnv_i32(&h, sc->has_sky);
+    /* Daylight: hashed only when present, so that forests saved before it
+     * existed keep their hash. */
+    if (sc->sky_map) {
+        const env_map *m = sc->sky_map;
+        fnv_i32(&h, m->width);
+        fnv_i32(&h, m->height);
+        fnv_bytes(&h, (const unsigned char *)m->rgb, (size_t)m->width * m->height * 3 * sizeof(float));
+        fnv_f64(&h, sc->sky_strength);
+        fnv_f64(&h, sc->sky_rotate);
+    }
+    if (sc->sun.present) {
+        fnv_v3(&h, sc->sun.direction);
+        fnv_v3(&h, sc->sun.irradiance);
+        fnv_f64(&h, sc->sun.angle);
+    }
     return h.h;
 }

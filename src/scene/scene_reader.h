@@ -34,6 +34,14 @@ zt_status load_transform(load_ctx *ctx, jref ref, double a[9], double t[3]);
  * model file); adds one object. */
 zt_status load_mesh_item(load_ctx *ctx, jref item, jref body, int line);
 
+/* The body of a "sky" item and of a "sun" item (item is the item). */
+zt_status load_sky(load_ctx *ctx, jref item, jref body);
+zt_status load_sun(load_ctx *ctx, jref item, jref body);
+
+/* After the scene list: draws a sky model (which follows the scene's sun)
+ * into the sky's map. */
+zt_status load_daylight_finish(load_ctx *ctx);
+
 /* The top-level "scene" list: adds every object to ctx->scene. */
 zt_status load_scene_list(load_ctx *ctx, jref ref);
 

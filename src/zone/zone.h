@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "render/render_internal.h"
+#include "light/distant.h"
 #include "zone/light/direct.h"
 #include "zone/light/occluders.h"
 #include "zone/maps/surface_nodes.h"
@@ -95,6 +96,10 @@ typedef struct zone_forest {
     int mesh_gather;    /* camera samples on meshes gather their diffuse
                            light of levels >= 2 (zone_gather_irradiance) */
     int sky;            /* the sky is not black: E_0 gathers it */
+    /* An environment map's gather: directions drawn from it by importance
+     * (world frame) and each one's radiance / (density x count). */
+    vec3f *sky_dirs, *sky_weight;
+    int sky_dir_count;
     int *glint_spheres; /* spheres that reflect lights as images (glint.h) */
     int glint_count;
     vec3 *dirs;         /* the gather directions (q.gather of them) */
@@ -159,6 +164,13 @@ typedef struct zone_trace {
 /* Irradiance of level `level` at point x (normal n) on side `side` of
  * primitive prim, read from the nodes. */
 vec3 zone_map_read(const zone_forest *f, const rscene *rs, int level, int prim, int side, vec3 x);
+
+/* The radiance of an escaping ray in direction d: the sky's colour or map,
+ * and the sun. */
+static inline vec3f zone_background(const rscene *rs, vec3f d)
+{
+    return rs->distant.any ? f3_add(rs->sky, distant_radiance(&rs->distant, d)) : rs->sky;
+}
 
 /* The sky's direct irradiance at x (normal n), gathered over the forest's
  * directions. */

@@ -258,13 +258,26 @@ static int occlude_with(const direct_ctx *c, const light_frame *f, vec3 x,
     return 0;
 }
 
+/* Light `light` as a primitive seen from x: a part, or the sun. */
+static void light_prim(const direct_ctx *c, int light, vec3 x, zprim *out)
+{
+    if (light != DIRECT_SUN) {
+        zprim_get(c->scene, c->rs, light, out);
+        return;
+    }
+    double dist = v3_length(v3_sub(x, c->far_centre)) + 2.0 * c->far_radius + 1.0;
+    *out = (zprim){.shape = SHAPE_SPHERE, .radius = dist * c->sun_sin, .is_light = 1,
+                   .object = -1};
+    out->p[0] = v3_add(x, v3_scale(c->sun_dir, dist));
+}
+
 /* The light's polygon on its plane as seen from x, in the frame's 2D
  * coordinates.  Returns 0 when x sees no side of it that emits. */
 static int light_polygon(const direct_ctx *c, int light, vec3 x, light_frame *f,
                          poly2 *out)
 {
     zprim lpp;
-    zprim_get(c->scene, c->rs, light, &lpp);
+    light_prim(c, light, x, &lpp);
     const zprim *lp = &lpp;
     poly3 light_poly;
     if (lp->shape == SHAPE_TRIANGLE) {
@@ -376,7 +389,7 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
 {
     const zt_scene *sc = c->scene;
     zprim lpp;
-    zprim_get(sc, c->rs, light, &lpp);
+    light_prim(c, light, x, &lpp);
     occ_region region;
     frustum fr;
     shadow_region(&lpp, f, x, set, &region, &fr);
@@ -550,7 +563,7 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
                                int split)
 {
     zprim lpp;
-    zprim_get(c->scene, c->rs, light, &lpp);
+    light_prim(c, light, x, &lpp);
     const zprim *lp = &lpp;
 
     if (lp->shape == SHAPE_POINT) {
@@ -605,7 +618,7 @@ int direct_by_rays(const direct_ctx *c, int light, vec3 x, vec3 n)
     if (clips_every_point(c))
         return 0;
     zprim lpp;
-    zprim_get(c->scene, c->rs, light, &lpp);
+    light_prim(c, light, x, &lpp);
     light_frame f;
     poly2 pieces[1];
     poly2_set set = {pieces, 1, 1, 0};
@@ -642,7 +655,7 @@ double direct_pixel_coverage(const direct_ctx *ctx, int light, vec3 eye,
     poly2 pieces[MAX_PIECES], scratch;
     poly2_set set = {pieces, 1, MAX_PIECES, 0};
     zprim lpp;
-    zprim_get(c->scene, c->rs, light, &lpp);
+    light_prim(c, light, eye, &lpp);
     if (lpp.shape == SHAPE_POINT || !light_polygon(c, light, eye, &f, &pieces[0]))
         return 0;
     /* The pixel's footprint on the light's plane: its corners seen from the

@@ -20,7 +20,20 @@ typedef struct direct_ctx {
      * can take (a mesh), the light is cut into about this many triangles,
      * each seen or hidden by a ray to its centre: exact as it grows. */
     int fallback;
+    /* The sun (light DIRECT_SUN): its unit direction and the sine of its
+     * angular radius; and a ball holding every finite primitive, beyond
+     * which the sun's disc is placed. */
+    vec3 sun_dir;
+    double sun_sin;
+    vec3 far_centre;
+    double far_radius;
 } direct_ctx;
+
+/* The light number of the sun: a disc of directions, taken as a light
+ * sphere beyond the scene that every point sees under the sun's angle
+ * (placed from the point, so that no two points see it differently), and
+ * occluded as the other lights are.  Its irradiance per unit radiance. */
+#define DIRECT_SUN (-2)
 
 /* Occluders clipped exactly at most; beyond, the fallback above. */
 #define DIRECT_MAX_OCCLUDERS 48

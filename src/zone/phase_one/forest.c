@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "light/env_map.h"
 #include "render/memory.h"
 #include "render/prim.h"
 #include "scene/mesh.h"
@@ -187,6 +188,36 @@ vec3 *zone_gather_directions(int n)
     return d;
 }
 
+/* The environment map's gather directions: a Hammersley set through the
+ * map's own sampling, so that a small bright patch gets its share of them
+ * (f->q.gather in all). */
+static int sky_map_directions(zone_forest *f, const rscene *rs)
+{
+    int n = f->q.gather;
+    f->sky_dirs = malloc((size_t)n * sizeof *f->sky_dirs);
+    f->sky_weight = malloc((size_t)n * sizeof *f->sky_weight);
+    if (!f->sky_dirs || !f->sky_weight)
+        return 0;
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        uint32_t b = (uint32_t)i;
+        b = (b << 16) | (b >> 16);
+        b = ((b & 0x55555555u) << 1) | ((b & 0xAAAAAAAAu) >> 1);
+        b = ((b & 0x33333333u) << 2) | ((b & 0xCCCCCCCCu) >> 2);
+        b = ((b & 0x0F0F0F0Fu) << 4) | ((b & 0xF0F0F0F0u) >> 4);
+        b = ((b & 0x00FF00FFu) << 8) | ((b & 0xFF00FF00u) >> 8);
+        float u[2] = {(float)((i + 0.5) / n), (float)(b * (1.0 / 4294967296.0))};
+        vec3f w, l;
+        float pdf = distant_map_sample(&rs->distant, u, &w, &l);
+        if (pdf <= 0.0f)
+            continue;
+        f->sky_dirs[k] = w;
+        f->sky_weight[k++] = f3_scale(l, 1.0f / (pdf * (float)n));
+    }
+    f->sky_dir_count = k;
+    return 1;
+}
+
 zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
 {
     const rscene *rs = &r->rs;
@@ -254,7 +285,17 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
                              o->weight[LOBE_REFRACTIVE] > 0))
             f->mesh_gather = 0;
     }
-    f->sky = !f3_is_black(rs->sky);
+    f->sky = !f3_is_black(rs->sky) || rs->distant.map;
+    if (rs->distant.map && !sky_map_directions(f, rs))
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    if (rs->distant.sun) {
+        /* The sun's disc lies beyond a ball holding the scene (direct.h). */
+        int finite = lo.x <= hi.x;
+        f->direct.sun_dir = f3_to_v3(rs->distant.sun_dir);
+        f->direct.sun_sin = sqrt((double)rs->distant.sun_sin2);
+        f->direct.far_centre = finite ? v3_scale(v3_add(lo, hi), 0.5) : v3(0, 0, 0);
+        f->direct.far_radius = finite ? 0.5 * v3_length(v3_sub(hi, lo)) : 1.0;
+    }
     if (rs->light_count > ZONE_LIGHTS_EXACT && !sender_tree_build_lights(&f->light_tree, rs))
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the light tree");
     return ZT_OK;
@@ -268,6 +309,8 @@ void zone_forest_free(zone_forest *f)
     free(f->e);
     free(f->glint_spheres);
     free(f->dirs);
+    free(f->sky_dirs);
+    free(f->sky_weight);
     sender_tree_free(&f->light_tree);
     memset(f, 0, sizeof *f);
 }
@@ -309,6 +352,16 @@ static void light_leaf(void *user, int i, vec3 x, vec3 n, double acc[3], cut_sta
         acc[ch] += g * em[ch];
 }
 
+/* The sun's direct irradiance at x, exactly (direct.h). */
+static vec3 sun_at(zone_trace *t, int receiver, vec3 x, vec3 n)
+{
+    const rs_distant *d = &t->r->rs.distant;
+    if (!d->sun)
+        return v3(0, 0, 0);
+    double g = direct_irradiance_split(&t->f->direct, DIRECT_SUN, x, n, receiver, t->light_split);
+    return v3_scale(f3_to_v3(d->sun_radiance), g);
+}
+
 vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n)
 {
     const rscene *rs = &t->r->rs;
@@ -319,9 +372,9 @@ vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n)
         vec3 e = cut_gather(&t->f->light_tree, rs, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)),
                             &p, &st, NULL);
         t->rays += st.rays;
-        return e;
+        return v3_add(e, sun_at(t, receiver, x, n));
     }
-    vec3 e = v3(0, 0, 0);
+    vec3 e = sun_at(t, receiver, x, n);
     for (int i = 0; i < rs->light_count; i++) {
         int prim = rs->lights[i].part;
         rs_part tmp;
@@ -425,16 +478,21 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
     }
     surfaces_present(rs, present);
     incident_flux(f, rs, flux);
-    /* The sky is no zone, but what it sends is light of level 0: as much as
-     * all the surfaces could take in. */
-    if (!f3_is_black(rs->sky)) {
+    /* The sky and the sun are no zones, but what they send is light of
+     * level 0: as much as all the surfaces could take in. */
+    double sky_lum = f3_luminance(rs->sky);
+    if (rs->distant.map)
+        sky_lum += rs->distant.map->mean_luminance * rs->distant.strength;
+    if (rs->distant.sun)
+        sky_lum += f3_luminance(rs->distant.sun_radiance) * rs->distant.sun_sin2;
+    if (sky_lum > 0) {
         double area = 0;
         for (int i = 0; i < rs->prim_count; i++) {
             rs_part tmp;
             const rs_part *p = rs_prim(rs, i, &tmp);
             area += p->shape == SHAPE_PLANE ? 0 : p->area;
         }
-        level_power[0] += f3_luminance(rs->sky) * 3.14159265358979 * (area > 0 ? area : 1.0);
+        level_power[0] += sky_lum * 3.14159265358979 * (area > 0 ? area : 1.0);
         if (rs->planes[0].count + rs->planes[1].count > 0)
             level_power[0] = INFINITY; /* an infinite plane under the sky */
     }

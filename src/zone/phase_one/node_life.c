@@ -10,13 +10,14 @@
 #define PROBES 8
 
 /* Whether plane part q hides the open half-space behind it from every
- * light: opaque, a thing, the sky black, every light in front of it. */
+ * light: opaque, a thing, the sky black (no map, no sun), every light in
+ * front of it. */
 static int is_wall(const zt_scene *sc, const rscene *rs, int q)
 {
     const part *pq = &sc->parts[q];
     const object *oq = &sc->objects[pq->object];
     if (pq->shape != SHAPE_PLANE || oq->is_light || oq->mat.weight[LOBE_REFRACTIVE] > 0 ||
-        !f3_is_black(rs->sky))
+        !f3_is_black(rs->sky) || rs->distant.any)
         return 0;
     double eps = 1e-9 * (1.0 + fabs(pq->offset));
     for (int l = 0; l < rs->light_count; l++) {

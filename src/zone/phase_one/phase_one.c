@@ -10,6 +10,7 @@
  *
  * Pixel level L reads E_{L-1} (level 1 is exact per pixel), so depth D
  * needs E_0 .. E_{D-1}. */
+#include <float.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -35,6 +36,21 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 {
     const zone_forest *f = t->f;
     const rscene *rs = &t->r->rs;
+    if (f->sky_dir_count) {
+        /* An environment map: its importance-drawn directions, each
+         * weighted by radiance over density. */
+        vec3f nf = v3_to_f3(n), o = ray_offset(v3_to_f3(x), nf);
+        vec3f e = f3_splat(0.0f);
+        for (int k = 0; k < f->sky_dir_count; k++) {
+            float c = f3_dot(nf, f->sky_dirs[k]);
+            if (c <= 0.0f)
+                continue;
+            t->rays++;
+            if (!accel_occluded(rs, o, f->sky_dirs[k], FLT_MAX, 1))
+                e = f3_madd(e, f->sky_weight[k], c);
+        }
+        return f3_to_v3(e);
+    }
     vec3 tt, bb;
     v3_frame(n, &tt, &bb);
     vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));

@@ -32,7 +32,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
     hit h = accel_intersect(rs, o, d);
     t->rays++;
     if (h.part < 0)
-        return lo <= 0 ? f3_to_v3(rs->sky) : v3(0, 0, 0);
+        return lo <= 0 ? f3_to_v3(zone_background(rs, d)) : v3(0, 0, 0);
     rs_part tmp;
     const rs_part *p = rs_prim(rs, h.part, &tmp);
     vec3f xf = f3_madd(o, d, h.t);

@@ -58,7 +58,7 @@ zt_status p2_terms_build(p2_terms *t, const zone_forest *f, const zt_renderer *r
         t->root_term[i] = -1;
     int ok = 1;
     /* The sky: not a zone of the forest; level 0 where the camera sees it. */
-    if (lo == 0 && !f3_is_black(rs->sky)) {
+    if (lo == 0 && (!f3_is_black(rs->sky) || rs->distant.any)) {
         p2_term term = {P2_SKY, -1, -1, ZONE_EMIT, 0};
         t->sky_term = t->count;
         ok = push_term(t, &cap, term);
@@ -277,10 +277,10 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
             }
         return;
     case P2_SKY: {
-        vec3 sky = f3_to_v3(t->r->rs.sky);
+        const rscene *rs = &t->r->rs;
         for (int i = 0; i < px->n; i++)
             if (px->s[i].part < 0)
-                add(acc, px->s[i].w, sky);
+                add(acc, px->s[i].w, f3_to_v3(zone_background(rs, px->s[i].d)));
         return;
     }
     default:
