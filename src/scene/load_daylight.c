@@ -46,13 +46,22 @@ static zt_status load_direction(load_ctx *ctx, jref ref, const char *what, vec3 
     return ZT_OK;
 }
 
+/* Whether s is exactly `pattern`, with 9 standing for any digit. */
+static int fits(const char *s, const char *pattern)
+{
+    for (; *pattern; s++, pattern++)
+        if (*pattern == '9' ? !(*s >= '0' && *s <= '9') : *s != *pattern)
+            return 0;
+    return *s == '\0';
+}
+
 /* "YYYY-MM-DD" */
 static zt_status load_date(load_ctx *ctx, jref ref, solar_time *t)
 {
     static const int days[12] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
-    int y, m, d, end = 0;
+    int y, m, d;
     const char *s = json_string_value(ref.value);
-    if (!s || sscanf(s, "%4d-%2d-%2d%n", &y, &m, &d, &end) != 3 || s[end] != '\0' ||
+    if (!s || !fits(s, "9999-99-99") || sscanf(s, "%4d-%2d-%2d", &y, &m, &d) != 3 ||
         m < 1 || m > 12 || d < 1 || d > days[m - 1] ||
         (m == 2 && d == 29 && !((y % 4 == 0 && y % 100 != 0) || y % 400 == 0)) ||
         y < 1 || y > 9999)
@@ -67,10 +76,10 @@ static zt_status load_date(load_ctx *ctx, jref ref, solar_time *t)
 /* "HH:MM" or "HH:MM:SS", local clock time. */
 static zt_status load_time(load_ctx *ctx, jref ref, solar_time *t)
 {
-    int h, m, sec = 0, end = 0;
+    int h = 0, m = 0, sec = 0;
     const char *s = json_string_value(ref.value);
-    int ok = s && ((sscanf(s, "%2d:%2d:%2d%n", &h, &m, &sec, &end) == 3 && s[end] == '\0') ||
-                   (sscanf(s, "%2d:%2d%n", &h, &m, &end) == 2 && s[end] == '\0'));
+    int ok = s && ((fits(s, "99:99:99") && sscanf(s, "%2d:%2d:%2d", &h, &m, &sec) == 3) ||
+                   (fits(s, "99:99") && sscanf(s, "%2d:%2d", &h, &m) == 2));
     if (!ok || h < 0 || h > 23 || m < 0 || m > 59 || sec < 0 || sec > 59)
         return load_fail(ctx, ref, "not a time: \"time\" must be a string \"HH:MM\" "
                          "or \"HH:MM:SS\" (local clock, 24 hours) such as \"15:00\"");
@@ -110,6 +119,9 @@ static zt_status load_place(load_ctx *ctx, jref ref, vec3 *dir)
                          "it is a direction on the ground");
     double elevation, azimuth;
     solar_position(&t, &elevation, &azimuth);
+    if (elevation <= 0)
+        return load_fail(ctx, ref, "the sun is below the horizon at that place and time "
+                         "(elevation %.1f degrees): daylight needs a sun above it", elevation);
     *dir = solar_direction(elevation, azimuth, north);
     return ZT_OK;
 }

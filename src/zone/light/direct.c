@@ -265,7 +265,10 @@ static void light_prim(const direct_ctx *c, int light, vec3 x, zprim *out)
         zprim_get(c->scene, c->rs, light, out);
         return;
     }
-    double dist = v3_length(v3_sub(x, c->far_centre)) + 2.0 * c->far_radius + 1.0;
+    /* Rays to the disc stop where they enter the sphere, (1 - sin r) of the
+     * way: that must lie beyond every primitive. */
+    double dist = (v3_length(v3_sub(x, c->far_centre)) + 2.0 * c->far_radius + 1.0) /
+                  (1.0 - c->sun_sin);
     *out = (zprim){.shape = SHAPE_SPHERE, .radius = dist * c->sun_sin, .is_light = 1,
                    .object = -1};
     out->p[0] = v3_add(x, v3_scale(c->sun_dir, dist));
