@@ -99,6 +99,9 @@ static const bad_case cases[] = {
     {"sky_turbidity_range", ITEM("{\"sky\": {\"model\": \"preetham\", \"turbidity\": 20, \"sun_direction\": [0, 1, 0]}}"), 3, 44, "turbidity"},
     {"sky_strength_on_color", ITEM("{\"sky\": {\"color\": [1, 1, 1], \"strength\": 2}}"), 3, 30, "belongs to a sky"},
     {"sky_file_not_string", ITEM("{\"sky\": {\"file\": 3}}"), 3, 18, "non-empty string"},
+    {"sun_place_at_night", ITEM("{\"sun\": {\"irradiance\": [1, 1, 1], \"place\": {\"latitude\": 49, \"longitude\": 8.4, \"utc_offset\": 2, \"date\": \"2026-06-21\", \"time\": \"23:30\"}}}"), 3, 44, "below the horizon"},
+    {"sun_loose_date", ITEM("{\"sun\": {\"irradiance\": [1, 1, 1], \"place\": {\"latitude\": 49, \"longitude\": 8.4, \"utc_offset\": 2, \"date\": \"2026-6-21\", \"time\": \"15:00\"}}}"), 3, 104, "not a date"},
+    {"sun_loose_time", ITEM("{\"sun\": {\"irradiance\": [1, 1, 1], \"place\": {\"latitude\": 49, \"longitude\": 8.4, \"utc_offset\": 2, \"date\": \"2026-06-21\", \"time\": \"9:5\"}}}"), 3, 126, "not a time"},
     /* numbers and ranges */
     {"too_large", ITEM("{\"sphere\": {\"center\": [0, 2e12, 0], \"radius\": 1}}"), 3, 27, "too large"},
     {"too_large_integer", ITEM("{\"sphere\": {\"center\": [0, 0, 0], \"radius\": 10000000000000}}"), 3, 44, "too large"},

@@ -84,6 +84,23 @@ float distant_pdf(const rs_distant *d, vec3f w)
     return p;
 }
 
+vec3f distant_eval(const rs_distant *d, vec3f w, float *pdf)
+{
+    if (!d->map || d->sampling != d->map) {
+        *pdf = distant_pdf(d, w);
+        return distant_radiance(d, w);
+    }
+    float map_pdf;
+    vec3f l = f3_scale(env_map_lookup(d->map, to_map(d, w), &map_pdf), d->strength);
+    float p = (1.0f - d->sun_select) * map_pdf;
+    if (distant_in_sun(d, w)) {
+        l = f3_add(l, d->sun_radiance);
+        p += d->sun_select / (2.0f * PI_F * d->sun_one_minus_cos);
+    }
+    *pdf = p;
+    return l;
+}
+
 vec3f distant_sun_direction(const rs_distant *d, const float u[2])
 {
     /* Uniform in the cone: 1 - cos theta uniform in [0, 1 - cos r]. */
@@ -119,7 +136,6 @@ int distant_sample(const rs_distant *d, float u_select, const float u[2], vec3f 
             return 0;
         *w = from_map(d, wm);
     }
-    *pdf = distant_pdf(d, *w);
-    *li = distant_radiance(d, *w);
+    *li = distant_eval(d, *w, pdf);
     return *pdf > 0.0f;
 }

@@ -22,6 +22,9 @@ int distant_in_sun(const rs_distant *d, vec3f w);
 /* The mixture's solid-angle density of direction w. */
 float distant_pdf(const rs_distant *d, vec3f w);
 
+/* distant_radiance and distant_pdf together, with one map lookup. */
+vec3f distant_eval(const rs_distant *d, vec3f w, float *pdf);
+
 /* Draws a direction: the sun or the map by u_select, the direction from
  * u[2].  Sets *w, its mixture density *pdf and the radiance *li arriving
  * from it; returns 0 when nothing can be drawn. */

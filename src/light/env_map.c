@@ -92,9 +92,10 @@ env_map *env_map_create(const float *rgb, int width, int height)
     m->rgb = malloc(sizeof(float) * 3 * texels);
     m->marginal_cdf = malloc(sizeof(float) * ((size_t)height + 1));
     m->conditional_cdf = malloc(sizeof(float) * ((size_t)width + 1) * (size_t)height);
+    m->row_cos = malloc(sizeof(double) * ((size_t)height + 1));
     /* Scratch: one row's texel weights, then every row's weight. */
     double *texel_weight = malloc(sizeof(double) * ((size_t)width + (size_t)height));
-    if (!m->rgb || !m->marginal_cdf || !m->conditional_cdf || !texel_weight) {
+    if (!m->rgb || !m->marginal_cdf || !m->conditional_cdf || !m->row_cos || !texel_weight) {
         free(texel_weight);
         env_map_release(m);
         return NULL;
@@ -103,6 +104,8 @@ env_map *env_map_create(const float *rgb, int width, int height)
     m->width = width;
     m->height = height;
     memcpy(m->rgb, rgb, sizeof(float) * 3 * texels);
+    for (int j = 0; j <= height; j++)
+        m->row_cos[j] = cos(ENV_PI * j / height);
 
     /* Within a row every texel has the same solid angle, so the row's
      * conditional cdf is over luminance alone, and the row's weight is its
@@ -141,6 +144,7 @@ void env_map_release(env_map *m)
     free(m->rgb);
     free(m->marginal_cdf);
     free(m->conditional_cdf);
+    free(m->row_cos);
     free(m);
 }
 
@@ -194,6 +198,13 @@ float env_map_pdf(const env_map *m, vec3f d)
     return (float)(texel_luminance(texel_of(m, d)) / m->weight_sum);
 }
 
+vec3f env_map_lookup(const env_map *m, vec3f d, float *pdf)
+{
+    const float *t = texel_of(m, d);
+    *pdf = m->weight_sum > 0.0 ? (float)(texel_luminance(t) / m->weight_sum) : 0.0f;
+    return f3(t[0], t[1], t[2]);
+}
+
 float env_map_sample(const env_map *m, const float u[2], vec3f *d)
 {
     if (!(m->weight_sum > 0.0)) {
@@ -217,7 +228,7 @@ float env_map_sample(const env_map *m, const float u[2], vec3f *d)
     /* Uniform in solid angle within the texel: u linear, cos theta linear
      * between the row's bounds.  In double, since near the poles cos theta
      * is within a float's rounding of 1 and the sine would be lost. */
-    double cos0 = cos(ENV_PI * j / h), cos1 = cos(ENV_PI * (j + 1) / h);
+    double cos0 = m->row_cos[j], cos1 = m->row_cos[j + 1];
     double ct = cos0 + fv * (cos1 - cos0);
     double uu = (i + fu) / w;
     /* The point is kept ENV_MARGIN radians inside the texel's edges and

@@ -29,6 +29,8 @@ typedef struct env_map {
      * luminance times its solid angle; rows of zero weight get none. */
     float *marginal_cdf;
     float *conditional_cdf;
+    double *row_cos;    /* cos of the polar angle at each row boundary
+                           (height + 1), for sampling */
     double weight_sum;  /* sum of luminance x solid angle (W/m^2 of luminance
                            over the whole sphere) */
     double mean_luminance; /* luminance averaged over the sphere by solid angle */
@@ -57,5 +59,9 @@ float env_map_sample(const env_map *m, const float u[2], vec3f *d);
 
 /* The solid-angle density with which env_map_sample draws d. */
 float env_map_pdf(const env_map *m, vec3f d);
+
+/* Both at once (one texel lookup): the radiance from d, and its density in
+ * *pdf. */
+vec3f env_map_lookup(const env_map *m, vec3f d, float *pdf);
 
 #endif

@@ -91,10 +91,10 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             if (counted) {
                 vec3f le = rs->sky;
                 if (rs->distant.any) {
-                    vec3f ld = distant_radiance(&rs->distant, d);
+                    float far_pdf;
+                    vec3f ld = distant_eval(&rs->distant, d, &far_pdf);
                     if (!prev_delta && !f3_is_black(ld))
-                        ld = f3_scale(ld, power_heuristic(prev_pdf,
-                                                          distant_pdf(&rs->distant, d)));
+                        ld = f3_scale(ld, power_heuristic(prev_pdf, far_pdf));
                     le = f3_add(le, ld);
                 }
                 radiance = f3_add(radiance, f3_mul(beta, le));
