@@ -14,6 +14,13 @@
 #include "zone/maps/surface_nodes.h"
 #include "zone/transfer/sender_tree.h"
 
+/* The open-surface irradiance table of an environment map: normals every
+ * 5.6 degrees (irradiance is the map seen through a cosine lobe, smooth in
+ * the normal), each from SKY_TABLE_SAMPLES directions drawn from the map. */
+#define ZONE_SKY_TABLE_W 64
+#define ZONE_SKY_TABLE_H 32
+#define ZONE_SKY_TABLE_SAMPLES 16384
+
 /* Up to this many light primitives, direct light sums them all exactly;
  * beyond (a mesh light), a cut through the light tree chooses which to
  * take exactly and which together. */
@@ -97,9 +104,13 @@ typedef struct zone_forest {
                            light of levels >= 2 (zone_gather_irradiance) */
     int sky;            /* the sky is not black: E_0 gathers it */
     /* An environment map's gather: directions drawn from it by importance
-     * (world frame) and each one's radiance / (density x count). */
+     * (world frame) and each one's radiance / (density x count); and the
+     * map's irradiance on an open surface of each normal (a table over the
+     * sphere of normals, laid out as the map's texels), which the gather
+     * scales by the share of its light that arrives. */
     vec3f *sky_dirs, *sky_weight;
     int sky_dir_count;
+    float *sky_open;    /* ZONE_SKY_TABLE_W x ZONE_SKY_TABLE_H x rgb */
     int *glint_spheres; /* spheres that reflect lights as images (glint.h) */
     int glint_count;
     vec3 *dirs;         /* the gather directions (q.gather of them) */

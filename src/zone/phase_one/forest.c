@@ -188,16 +188,11 @@ vec3 *zone_gather_directions(int n)
     return d;
 }
 
-/* The environment map's gather directions: a Hammersley set through the
- * map's own sampling, so that a small bright patch gets its share of them
- * (f->q.gather in all). */
-static int sky_map_directions(zone_forest *f, const rscene *rs)
+/* n directions drawn from the map (a Hammersley set through its own
+ * sampling, so that a small bright patch gets its share of them), each with
+ * its radiance / (density x n); returns how many carry light. */
+static int map_directions(const rscene *rs, int n, vec3f *dirs, vec3f *weight)
 {
-    int n = f->q.gather;
-    f->sky_dirs = malloc((size_t)n * sizeof *f->sky_dirs);
-    f->sky_weight = malloc((size_t)n * sizeof *f->sky_weight);
-    if (!f->sky_dirs || !f->sky_weight)
-        return 0;
     int k = 0;
     for (int i = 0; i < n; i++) {
         uint32_t b = (uint32_t)i;
@@ -211,10 +206,47 @@ static int sky_map_directions(zone_forest *f, const rscene *rs)
         float pdf = distant_map_sample(&rs->distant, u, &w, &l);
         if (pdf <= 0.0f)
             continue;
-        f->sky_dirs[k] = w;
-        f->sky_weight[k++] = f3_scale(l, 1.0f / (pdf * (float)n));
+        dirs[k] = w;
+        weight[k++] = f3_scale(l, 1.0f / (pdf * (float)n));
     }
-    f->sky_dir_count = k;
+    return k;
+}
+
+/* The environment map's gather directions (f->q.gather of them) and its
+ * open-surface irradiance table (zone.h). */
+static int sky_map_directions(zone_forest *f, const rscene *rs)
+{
+    int n = f->q.gather, m = ZONE_SKY_TABLE_SAMPLES;
+    f->sky_dirs = malloc((size_t)n * sizeof *f->sky_dirs);
+    f->sky_weight = malloc((size_t)n * sizeof *f->sky_weight);
+    f->sky_open = malloc((size_t)ZONE_SKY_TABLE_W * ZONE_SKY_TABLE_H * 3 * sizeof(float));
+    vec3f *dirs = malloc((size_t)m * sizeof *dirs), *weight = malloc((size_t)m * sizeof *weight);
+    if (!f->sky_dirs || !f->sky_weight || !f->sky_open || !dirs || !weight) {
+        free(dirs);
+        free(weight);
+        return 0;
+    }
+    f->sky_dir_count = map_directions(rs, n, f->sky_dirs, f->sky_weight);
+    int count = map_directions(rs, m, dirs, weight);
+    for (int j = 0; j < ZONE_SKY_TABLE_H; j++)
+        for (int i = 0; i < ZONE_SKY_TABLE_W; i++) {
+            vec3f nrm = env_map_direction((i + 0.5f) / ZONE_SKY_TABLE_W,
+                                          (j + 0.5f) / ZONE_SKY_TABLE_H);
+            double e[3] = {0, 0, 0};
+            for (int k = 0; k < count; k++) {
+                float c = f3_dot(nrm, dirs[k]);
+                if (c > 0.0f) {
+                    e[0] += weight[k].x * c;
+                    e[1] += weight[k].y * c;
+                    e[2] += weight[k].z * c;
+                }
+            }
+            float *t = f->sky_open + 3 * ((size_t)j * ZONE_SKY_TABLE_W + i);
+            for (int ch = 0; ch < 3; ch++)
+                t[ch] = (float)e[ch];
+        }
+    free(dirs);
+    free(weight);
     return 1;
 }
 
@@ -311,6 +343,7 @@ void zone_forest_free(zone_forest *f)
     free(f->dirs);
     free(f->sky_dirs);
     free(f->sky_weight);
+    free(f->sky_open);
     sender_tree_free(&f->light_tree);
     memset(f, 0, sizeof *f);
 }

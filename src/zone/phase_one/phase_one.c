@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "geom/accel.h"
+#include "light/env_map.h"
 #include "geom/ray_offset.h"
 #include "render/share.h"
 #include "util/error.h"
@@ -32,24 +33,51 @@
 #include "zone/transfer/transfer.h"
 #include "zone/zone.h"
 
+/* The map's irradiance on an open surface of unit normal n: the table
+ * read bilinearly between its normals (around in azimuth, clamped at the
+ * poles). */
+static vec3 sky_open_irradiance(const zone_forest *f, vec3f n)
+{
+    float u, v;
+    env_map_uv(n, &u, &v);
+    float fx = u * ZONE_SKY_TABLE_W - 0.5f, fy = v * ZONE_SKY_TABLE_H - 0.5f;
+    int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
+    float ax = fx - (float)x0, ay = fy - (float)y0;
+    vec3 e = v3(0, 0, 0);
+    for (int dy = 0; dy < 2; dy++)
+        for (int dx = 0; dx < 2; dx++) {
+            int xi = ((x0 + dx) % ZONE_SKY_TABLE_W + ZONE_SKY_TABLE_W) % ZONE_SKY_TABLE_W;
+            int yi = y0 + dy < 0 ? 0 : (y0 + dy >= ZONE_SKY_TABLE_H ? ZONE_SKY_TABLE_H - 1 : y0 + dy);
+            double w = (dx ? ax : 1 - ax) * (dy ? ay : 1 - ay);
+            const float *t = f->sky_open + 3 * ((size_t)yi * ZONE_SKY_TABLE_W + xi);
+            e = v3_add(e, v3_scale(v3(t[0], t[1], t[2]), w));
+        }
+    return e;
+}
+
 vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 {
     const zone_forest *f = t->f;
     const rscene *rs = &t->r->rs;
     if (f->sky_dir_count) {
-        /* An environment map: its importance-drawn directions, each
-         * weighted by radiance over density. */
+        /* An environment map: the open-surface irradiance of the normal,
+         * times the share of it that the importance-drawn directions find
+         * arriving (a ratio estimate: exact where nothing is in the way). */
         vec3f nf = v3_to_f3(n), o = ray_offset(v3_to_f3(x), nf);
-        vec3f e = f3_splat(0.0f);
+        vec3f seen = f3_splat(0.0f), all = f3_splat(0.0f);
         for (int k = 0; k < f->sky_dir_count; k++) {
             float c = f3_dot(nf, f->sky_dirs[k]);
             if (c <= 0.0f)
                 continue;
             t->rays++;
+            all = f3_madd(all, f->sky_weight[k], c);
             if (!accel_occluded(rs, o, f->sky_dirs[k], FLT_MAX, 1))
-                e = f3_madd(e, f->sky_weight[k], c);
+                seen = f3_madd(seen, f->sky_weight[k], c);
         }
-        return f3_to_v3(e);
+        vec3 open = sky_open_irradiance(f, nf);
+        return v3(all.x > 0.0f ? open.x * seen.x / all.x : open.x,
+                  all.y > 0.0f ? open.y * seen.y / all.y : open.y,
+                  all.z > 0.0f ? open.z * seen.z / all.z : open.z);
     }
     vec3 tt, bb;
     v3_frame(n, &tt, &bb);
