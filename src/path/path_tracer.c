@@ -90,7 +90,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         if (h.part < 0) {
             if (counted) {
                 vec3f le = rs->sky;
-                if (rs->distant.any) {
+                if (__builtin_expect(rs->distant.any, 0)) {
                     float far_pdf;
                     vec3f ld = distant_eval(&rs->distant, d, &far_pdf);
                     if (!prev_delta && !f3_is_black(ld))
@@ -184,7 +184,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         }
 
         /* Next-event estimation of light from far away. */
-        if (nee && rs->distant.any) {
+        if (__builtin_expect(nee && rs->distant.any, 0)) {
             float u_far[2], u_pick = rs->distant.map && rs->distant.sun ? sampler_next(&rng) : 0.0f;
             if (k <= STRATIFIED_VERTICES) {
                 sampler_get2_seeded(px->pair_seed[DISTANT_PAIR], rev_index, u_far);
