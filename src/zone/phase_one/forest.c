@@ -11,6 +11,7 @@
 #include "render/prim.h"
 #include "scene/mesh.h"
 #include "util/error.h"
+#include "util/sampler.h"
 #include "util/vec3_convert.h"
 #include "geom/ray_offset.h"
 #include "zone/phase_one/glint.h"
@@ -175,12 +176,7 @@ vec3 *zone_gather_directions(int n)
     if (!d)
         return NULL;
     for (int i = 0; i < n; i++) {
-        uint32_t b = (uint32_t)i;
-        b = (b << 16) | (b >> 16);
-        b = ((b & 0x55555555u) << 1) | ((b & 0xAAAAAAAAu) >> 1);
-        b = ((b & 0x33333333u) << 2) | ((b & 0xCCCCCCCCu) >> 2);
-        b = ((b & 0x0F0F0F0Fu) << 4) | ((b & 0xF0F0F0F0u) >> 4);
-        b = ((b & 0x00FF00FFu) << 8) | ((b & 0xFF00FF00u) >> 8);
+        uint32_t b = sampler_reverse_bits((uint32_t)i);
         double u1 = (i + 0.5) / n, u2 = b * (1.0 / 4294967296.0);
         double r = sqrt(u1), phi = 2 * 3.14159265358979 * u2;
         d[i] = v3(r * cos(phi), r * sin(phi), sqrt(fmax(0.0, 1.0 - u1)));
@@ -195,12 +191,7 @@ static int map_directions(const rscene *rs, int n, vec3f *dirs, vec3f *weight)
 {
     int k = 0;
     for (int i = 0; i < n; i++) {
-        uint32_t b = (uint32_t)i;
-        b = (b << 16) | (b >> 16);
-        b = ((b & 0x55555555u) << 1) | ((b & 0xAAAAAAAAu) >> 1);
-        b = ((b & 0x33333333u) << 2) | ((b & 0xCCCCCCCCu) >> 2);
-        b = ((b & 0x0F0F0F0Fu) << 4) | ((b & 0xF0F0F0F0u) >> 4);
-        b = ((b & 0x00FF00FFu) << 8) | ((b & 0xFF00FF00u) >> 8);
+        uint32_t b = sampler_reverse_bits((uint32_t)i);
         float u[2] = {(float)((i + 0.5) / n), (float)(b * (1.0 / 4294967296.0))};
         vec3f w, l;
         float pdf = distant_map_sample(&rs->distant, u, &w, &l);
