@@ -196,12 +196,52 @@ static void test_room_of_planes(void **state)
     zt_scene_release(s);
 }
 
+/* A diffuse sphere floating over a ground plane under a point light: the
+ * light the sphere's lit side sends onto the ground (level 2) reaches the
+ * ground's nodes.  A sphere's sending cells are flat polygons between its
+ * nodes, inside the sphere; rays toward them used to meet the sphere and
+ * find every cell hidden, and the ground's level 2 was 17% dark on average
+ * (nothing at all beside the sphere).  The mean of the image against the
+ * path tracer's (1,024 spp, whose two seeds differ by 0.3%): within 3%. */
+static void test_sphere_lights_the_ground(void **state)
+{
+    (void)state;
+    const char *text =
+        "{\"camera\": {\"position\": [6, 4, 7], \"lookat\": [0, 0.6, 0], \"fov\": 40, "
+        "\"gridresolution\": [32, 32]}, \"scene\": ["
+        "{\"lightpoint\": {\"point\": [50, 70, 35], \"emission\": [8e6, 8e6, 8e6]}},"
+        "{\"plane\": {\"normal\": [0, 1, 0], \"offset\": 0, " TEST_DIFFUSE(0.5) "}},"
+        "{\"sphere\": {\"center\": [-1, 1.5, 0.5], \"radius\": 1, " TEST_DIFFUSE(0.7) "}}]}";
+    zt_scene *s = test_scene_text(text, "sphere_over_ground");
+    double mean[2];
+    for (int m = 0; m < 2; m++) {
+        zt_render_options o = zt_render_options_default();
+        o.method = m ? ZT_METHOD_ZONE : ZT_METHOD_PATH;
+        o.level = 2;
+        o.spp = 1024;
+        zt_image *img = NULL;
+        zt_error err = {0};
+        if (zt_render(s, &o, &img, NULL, &err) != ZT_OK)
+            fail_msg("render: %s", err.message);
+        double sum = 0;
+        for (int i = 0; i < img->width * img->height; i++)
+            sum += img->pixels[3 * i + 1];
+        mean[m] = sum / (img->width * img->height);
+        zt_image_release(img);
+    }
+    print_message("level 2 over the ground: zone %.4f, path %.4f (%+.2f%%)\n", mean[1], mean[0],
+                  100 * (mean[1] / mean[0] - 1));
+    assert_true(fabs(mean[1] / mean[0] - 1) < 0.03);
+    zt_scene_release(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_levels_against_references),
         cmocka_unit_test(test_error_shrinks_with_quality),
         cmocka_unit_test(test_room_of_planes),
+        cmocka_unit_test(test_sphere_lights_the_ground),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

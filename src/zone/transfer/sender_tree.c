@@ -67,6 +67,22 @@ static int make_elem(sender_elem *el, const surface_nodes *sn, const rscene *rs,
         return 0;
     c = v3_scale(c, 1.0 / area);
     vec3 n = v3_normalize(s);
+    rs_part tmp;
+    const rs_part *sp = rs_prim(rs, prim, &tmp);
+    if (sp->shape == SHAPE_SPHERE && side == 0) {
+        /* A sphere's cell is a flat polygon between its nodes, inside the
+         * sphere: rays from outside toward its centroid (the cut's
+         * visibility, through the representatives) would meet the sphere
+         * itself and find every cell hidden.  The centroid goes out onto
+         * the surface, the normal along the radius.  (The inner side is
+         * seen from inside, where the cell's own centroid is right.) */
+        vec3 centre = f3_to_v3(sp->p0), d = v3_sub(c, centre);
+        double len = v3_length(d);
+        if (len > 0) {
+            n = v3_scale(d, 1.0 / len);
+            c = v3_add(centre, v3_scale(d, sp->radius / len));
+        }
+    }
     el->prim = prim;
     el->index = e;
     el->side = (uint8_t)side;
@@ -82,8 +98,7 @@ static int make_elem(sender_elem *el, const surface_nodes *sn, const rscene *rs,
             el->hi[a] = fmaxf(el->hi[a], (float)v[a]);
         }
     }
-    rs_part tmp;
-    el->background = rs_prim(rs, prim, &tmp)->background;
+    el->background = sp->background;
     el->c[0] = (float)c.x, el->c[1] = (float)c.y, el->c[2] = (float)c.z;
     el->n[0] = (float)n.x, el->n[1] = (float)n.y, el->n[2] = (float)n.z;
     el->area = (float)area;

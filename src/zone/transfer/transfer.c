@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "geom/ray_offset.h"
+#include "render/prim.h"
 #include "util/vec3_convert.h"
 #include "zone/light/lambert.h"
 #include "zone/transfer/cut.h"
@@ -24,10 +25,22 @@ typedef struct gather {
     vec3 x, n;
     vec3f xo;           /* ray origin off the surface */
     cut_stats *st;
+    /* The sender's sphere, when it sends from its outer side (radius 0:
+     * not): its elements are flat cells between nodes on the sphere,
+     * inside it, so rays toward them aim at the surface above them
+     * instead, or the sphere would hide them all. */
+    vec3 sphere_c;
+    double sphere_r;
 } gather;
 
 static int visible(gather *g, vec3 to, int background)
 {
+    if (g->sphere_r > 0) {
+        vec3 d = v3_sub(to, g->sphere_c);
+        double len = v3_length(d);
+        if (len > 0)
+            to = v3_add(g->sphere_c, v3_scale(d, g->sphere_r / len));
+    }
     return cut_visible(g->c->rs, g->xo, to, background, g->st);
 }
 
@@ -192,6 +205,10 @@ static void element(gather *g, int i, double acc[3])
     vec3 q[4];
     int32_t node[4];
     int corners = surface_element(g->c->sn, g->c->rs, el->prim, el->side, el->index, q, node);
+    rs_part tmp;
+    const rs_part *sp = rs_prim(g->c->rs, el->prim, &tmp);
+    g->sphere_r = sp->shape == SHAPE_SPHERE && el->side == 0 ? sp->radius : 0;
+    g->sphere_c = f3_to_v3(sp->p0);
     /* Each corner's radiance: its node's, or the element's mean where the
      * node is dead (or a sphere's pole). */
     double b[12];
@@ -206,7 +223,7 @@ static void element(gather *g, int i, double acc[3])
 
 static void leaf(void *user, int i, vec3 x, vec3 n, double acc[3], cut_stats *st)
 {
-    gather g = {user, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)), st};
+    gather g = {user, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)), st, {0, 0, 0}, 0};
     element(&g, i, acc);
 }
 
