@@ -95,3 +95,11 @@ int load_line(const load_ctx *ctx, jref ref)
     size_t original = source_map_original(ctx->map, ref_offset(ctx, ref));
     return source_map_locate(ctx->map, original, &line, &column) ? line : 0;
 }
+
+void load_file_path(const load_ctx *ctx, const char *file, char *out, size_t size)
+{
+    if (file[0] == '/' || !ctx->dir || !ctx->dir[0])
+        snprintf(out, size, "%s", file);
+    else
+        snprintf(out, size, "%s%s", ctx->dir, file);
+}

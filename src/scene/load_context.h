@@ -65,4 +65,8 @@ zt_status load_fail_offset(load_ctx *ctx, zt_status status, size_t parsed,
 /* The line of ref's value in the file, or 0. */
 int load_line(const load_ctx *ctx, jref ref);
 
+/* A file named in the scene (a model, a map): as written when absolute,
+ * else in the scene's folder. */
+void load_file_path(const load_ctx *ctx, const char *file, char *out, size_t size);
+
 #endif

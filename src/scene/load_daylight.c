@@ -193,12 +193,8 @@ static zt_status load_sky_file(load_ctx *ctx, jref file)
     if (!json_is_string(file.value) || json_string_length(file.value) == 0)
         return load_fail(ctx, file, "wrong type: a sky's file must be a non-empty string "
                          "(an image path relative to the scene file)");
-    const char *name = json_string_value(file.value);
     char path[4096];
-    if (name[0] == '/' || !ctx->dir || !ctx->dir[0])
-        snprintf(path, sizeof path, "%s", name);
-    else
-        snprintf(path, sizeof path, "%s%s", ctx->dir, name);
+    load_file_path(ctx, json_string_value(file.value), path, sizeof path);
     zt_image *im = NULL;
     zt_error ierr;
     zt_error_clear(&ierr);

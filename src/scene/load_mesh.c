@@ -92,15 +92,6 @@ zt_status load_transform(load_ctx *ctx, jref ref, double a[9], double t[3])
     return ZT_OK;
 }
 
-/* The model's path: as written when absolute, else in the scene's folder. */
-static void model_path(const load_ctx *ctx, const char *file, char *out, size_t size)
-{
-    if (file[0] == '/' || !ctx->dir || !ctx->dir[0])
-        snprintf(out, size, "%s", file);
-    else
-        snprintf(out, size, "%s%s", ctx->dir, file);
-}
-
 zt_status load_mesh_item(load_ctx *ctx, jref item, jref body, int line)
 {
     static const char *const keys[] = {"file", "material", "emission", "transform",
@@ -145,7 +136,7 @@ zt_status load_mesh_item(load_ctx *ctx, jref item, jref body, int line)
     }
 
     char path[4096];
-    model_path(ctx, json_string_value(file.value), path, sizeof path);
+    load_file_path(ctx, json_string_value(file.value), path, sizeof path);
     model_import_options opt = {.smooth = smooth};
     mesh *m = NULL;
     zt_error ierr;

@@ -314,8 +314,8 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
     if (rs->distant.sun) {
         /* The sun's disc lies beyond a ball holding the scene (direct.h). */
         int finite = lo.x <= hi.x;
-        f->direct.sun_dir = f3_to_v3(rs->distant.sun_dir);
-        f->direct.sun_sin = sqrt((double)rs->distant.sun_sin2);
+        f->direct.sun_dir = r->scene->sun.direction; /* in double, as written */
+        f->direct.sun_sin = sin(0.5 * r->scene->sun.angle);
         f->direct.far_centre = finite ? v3_scale(v3_add(lo, hi), 0.5) : v3(0, 0, 0);
         f->direct.far_radius = finite ? 0.5 * v3_length(v3_sub(hi, lo)) : 1.0;
     }
