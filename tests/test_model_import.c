@@ -532,6 +532,69 @@ static void test_missing_texture_noted(void **state)
     zt_scene_release(s);
 }
 
+/* Normals made for a file without them: a cube's corners stay corners
+ * (every vertex normal of a triangle is the triangle's own), and a prism of
+ * 12 sides (30 degrees between neighbouring faces) shades smooth (its
+ * side's vertex normals point straight out from the axis). */
+static void test_made_normals_keep_corners(void **state)
+{
+    (void)state;
+    test_write_file("cube.obj",
+                    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n");
+    zt_scene *s = load_ok(write_scene("s_cube.json", "cube.obj", ""));
+    const mesh *m = only_mesh(s);
+    assert_non_null(m->normal);
+    assert_int_equal(m->triangle_count, 12);
+    for (int t = 0; t < m->triangle_count; t++) {
+        double p[3][3], e1[3], e2[3], g[3];
+        for (int c = 0; c < 3; c++)
+            for (int a = 0; a < 3; a++)
+                p[c][a] = m->position[3 * m->index[3 * t + c] + a];
+        for (int a = 0; a < 3; a++) {
+            e1[a] = p[1][a] - p[0][a];
+            e2[a] = p[2][a] - p[0][a];
+        }
+        g[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        g[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        g[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double l = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        for (int c = 0; c < 3; c++) {
+            const float *n = m->normal + 3 * m->index[3 * t + c];
+            double dot = (n[0] * g[0] + n[1] * g[1] + n[2] * g[2]) / l;
+            if (!(dot > 0.9999))
+                fail_msg("triangle %d corner %d: normal (%g, %g, %g) is not its face's", t, c,
+                         n[0], n[1], n[2]);
+        }
+    }
+    zt_scene_release(s);
+
+    char text[4096];
+    size_t len = 0;
+    for (int k = 0; k < 12; k++) {
+        double a = 2 * 3.14159265358979 * k / 12;
+        len += (size_t)snprintf(text + len, sizeof text - len, "v %.9f 0 %.9f\nv %.9f 1 %.9f\n",
+                                cos(a), sin(a), cos(a), sin(a));
+    }
+    for (int k = 0; k < 12; k++) {
+        int b = 2 * k + 1, c = 2 * ((k + 1) % 12) + 1;
+        len += (size_t)snprintf(text + len, sizeof text - len, "f %d %d %d %d\n", b, b + 1, c + 1,
+                                c);
+    }
+    test_write_file("prism.obj", text);
+    s = load_ok(write_scene("s_prism.json", "prism.obj", ""));
+    m = only_mesh(s);
+    assert_non_null(m->normal);
+    for (int v = 0; v < m->vertex_count; v++) {
+        const float *p = m->position + 3 * v, *n = m->normal + 3 * v;
+        double r = sqrt(p[0] * p[0] + p[2] * p[2]);
+        double dot = fabs(n[0] * p[0] + n[2] * p[2]) / r;
+        if (!(dot > 0.9999) || !(fabs(n[1]) < 1e-4))
+            fail_msg("prism vertex %d: normal (%g, %g, %g) is not radial", v, n[0], n[1], n[2]);
+    }
+    zt_scene_release(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -544,6 +607,7 @@ int main(void)
         cmocka_unit_test(test_texture_texels_and_lookup),
         cmocka_unit_test(test_texture_rendered),
         cmocka_unit_test(test_missing_texture_noted),
+        cmocka_unit_test(test_made_normals_keep_corners),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -16,6 +16,7 @@
 #include <time.h>
 
 #include <assimp/cimport.h>
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -39,13 +40,22 @@ static void log_message(const char *message, char *user)
 }
 
 /* aiImportFile with the log heard. */
+/* Degrees: docs/scene-format.md, "Shading normals". */
+#define SMOOTHING_ANGLE 60.0f
+
 static const struct aiScene *import_listening(const char *path, unsigned flags, import_log *log)
 {
     memset(log, 0, sizeof *log);
     pthread_mutex_lock(&import_lock);
     struct aiLogStream stream = {log_message, (char *)(void *)log};
     aiAttachLogStream(&stream);
-    const struct aiScene *sc = aiImportFile(path, flags);
+    /* Normals made for a file without them are averaged only across
+     * edges whose faces meet at less than this (Assimp's default, 175
+     * degrees, bent every box's walls toward its corners). */
+    struct aiPropertyStore *props = aiCreatePropertyStore();
+    aiSetImportPropertyFloat(props, AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, SMOOTHING_ANGLE);
+    const struct aiScene *sc = aiImportFileExWithProperties(path, flags, NULL, props);
+    aiReleasePropertyStore(props);
     aiDetachLogStream(&stream);
     pthread_mutex_unlock(&import_lock);
     return sc;
