@@ -318,6 +318,7 @@ static void test_lights_add_up(void **state)
     (void)state;
     zt_scene *s = scene_from(box_text);
     zt_render_options o = zone_options(2, 2);
+    o.quality = 2;
     zt_image *all = render(s, &o, NULL);
     o.lights_off_count = 1;
     o.lights_off[0] = 1;
@@ -329,11 +330,13 @@ static void test_lights_add_up(void **state)
     for (size_t i = 0; i < floats(a); i++)
         a->pixels[i] += b->pixels[i];
     /* Each image is the forest of its own lights: the transfer's cut and
-     * the node grids' refinement adapt to the light present, so the parts
-     * add up to the whole within the cut's error bound (measured 0.05%),
-     * not to the last bit. */
+     * the node grids' refinement adapt to the light present, and a node
+     * gathers or cuts by the light it holds (bounce_gather.h), so the parts
+     * add up to the whole within those estimates' errors, not to the last
+     * bit: measured 0.36% at quality 2 (the cuts alone: 0.05%), and 4.5% at
+     * quality 0, whose 64 directions a node gathers with are few. */
     double e = rel_rmse(a, all);
-    if (!(e < 2e-3))
+    if (!(e < 5e-3))
         fail_msg("light 0 + light 1 vs both: rel_rmse %g", e);
     zt_image_release(a);
     zt_image_release(b);

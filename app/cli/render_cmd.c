@@ -162,12 +162,13 @@ static void print_zone_stats(const zt_render_stats *s, const char *loaded_from)
             fprintf(stderr, " level %d: %llu,", l, (unsigned long long)s->zones_per_level[l]);
     fprintf(stderr, " total %llu; pruned %llu\n", (unsigned long long)s->zones,
             (unsigned long long)s->zones_pruned);
-    if (s->cuts)
+    if (s->cuts || s->nodes_gathered)
         fprintf(stderr,
-                "transfer: %llu cuts, %llu (%.1f%%) reached the cluster limit, %llu started "
-                "from a neighbour's\n",
-                (unsigned long long)s->cuts, (unsigned long long)s->cuts_capped,
-                100.0 * (double)s->cuts_capped / (double)s->cuts,
+                "transfer: %llu nodes gathered; %llu cuts, %llu (%.1f%%) reached the cluster "
+                "limit, %llu started from a neighbour's\n",
+                (unsigned long long)s->nodes_gathered, (unsigned long long)s->cuts,
+                (unsigned long long)s->cuts_capped,
+                s->cuts ? 100.0 * (double)s->cuts_capped / (double)s->cuts : 0.0,
                 (unsigned long long)s->cuts_shared);
     fprintf(stderr, "forest memory: %llu bytes (%.1f MiB: zones, occluder lists and maps)\n",
             (unsigned long long)s->memory_bytes, s->memory_bytes / 1048576.0);

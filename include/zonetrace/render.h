@@ -152,6 +152,8 @@ typedef struct zt_render_stats {
                               (docs/zone-tracer.md) */
     uint64_t cuts_shared;  /* of which started from a nearby node's cut
                               (a mesh's vertex nodes in groups) */
+    uint64_t nodes_gathered; /* zone, Phase One: nodes whose transfer was
+                              gathered instead of cut (docs/zone-tracer.md) */
     int forest_loaded;     /* zone: the forest came from options.forest_file
                               (phase_one_seconds is then the time to read it) */
     /* zt_render */

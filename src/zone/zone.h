@@ -114,10 +114,13 @@ typedef struct zone_forest {
     int *glint_spheres; /* spheres that reflect lights as images (glint.h) */
     int glint_count;
     vec3 *dirs;         /* the gather directions (q.gather of them) */
+    vec3 *bounce_dirs;  /* the transfer's gather directions (q.gather,
+                           bounce_gather.h) */
     uint64_t links;     /* Phase One: clusters and elements the transfer took */
     uint64_t cuts;      /* transfer cuts made (not kept in forest files) */
     uint64_t cuts_capped; /* of which stopped at their size limit */
     uint64_t cuts_shared; /* of which started from a neighbour's cut */
+    uint64_t gathers;   /* nodes whose transfer was gathered instead */
     double phase_one_seconds;
     uint64_t rays;
     int loaded;         /* read from a forest file (forest_io.c), not built */

@@ -24,6 +24,7 @@ static void fill_forest_stats(const zone_forest *f, const zt_renderer *r, zt_ren
     stats->cuts = f->cuts;
     stats->cuts_capped = f->cuts_capped;
     stats->cuts_shared = f->cuts_shared;
+    stats->nodes_gathered = f->gathers;
     /* Here, not only at creation: a renderer made without stats (saving
      * its forest first) reports it with its first image. */
     stats->memory_estimate = r->memory_estimate + memory_zone_nodes(f->sn.node_count, f->map_levels);

@@ -15,6 +15,7 @@
 #include "util/vec3_convert.h"
 #include "geom/ray_offset.h"
 #include "zone/phase_one/glint.h"
+#include "zone/transfer/bounce_gather.h"
 #include "zone/transfer/cut.h"
 #include "zone/zone.h"
 
@@ -280,8 +281,9 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
     f->direct.sides = f->q.sides;
     f->direct.fallback = f->q.fallback;
     f->dirs = zone_gather_directions(f->q.gather);
+    f->bounce_dirs = bounce_directions(f->q.gather);
     f->glint_spheres = malloc(((size_t)rs->part_count + 1) * sizeof(int));
-    if (!f->dirs || !f->glint_spheres)
+    if (!f->dirs || !f->bounce_dirs || !f->glint_spheres)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     f->glint_count = 0;
     for (int i = 0; i < rs->part_count; i++)
@@ -332,6 +334,7 @@ void zone_forest_free(zone_forest *f)
     free(f->e);
     free(f->glint_spheres);
     free(f->dirs);
+    free(f->bounce_dirs);
     free(f->sky_dirs);
     free(f->sky_weight);
     free(f->sky_open);

@@ -29,6 +29,7 @@
 #include "zone/phase_one/caustic.h"
 #include "zone/phase_one/glint.h"
 #include "zone/phase_one/node_life.h"
+#include "zone/transfer/bounce_gather.h"
 #include "zone/transfer/sender_tree.h"
 #include "zone/transfer/transfer.h"
 #include "zone/zone.h"
@@ -163,28 +164,46 @@ static vec3 node_point(const surface_nodes *sn, int32_t k, vec3 *n)
     return v3(sn->pos[3 * k], sn->pos[3 * k + 1], sn->pos[3 * k + 2]);
 }
 
+/* The luminance of node k's light at the levels below `level`. */
+static double light_below(const zone_forest *f, int level, int32_t k)
+{
+    double y = 0;
+    for (int j = 0; j < level; j++) {
+        const float *v = zone_e(f, j, k);
+        y += 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
+    }
+    return y;
+}
+
 /* Level `level`'s irradiance at live node k (without the caustics).  At
- * a level with a transfer the node's cut is kept in rec (if any), or
- * started from `from`, a nearby node's (if any). */
+ * a level with a transfer the node gathers it where the gather is good
+ * enough (bounce_gather.h; *gathered is then set), else takes a cut, kept
+ * in rec (if any) or started from `from`, a nearby node's (if any). */
 static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const transfer_ctx *tc,
                        int32_t k, cut_record *rec, const cut_record *from, uint64_t *rays,
-                       uint64_t *links, uint64_t *capped)
+                       uint64_t *links, uint64_t *capped, int *gathered)
 {
     const surface_nodes *sn = &f->sn;
     zone_trace t = {.f = f, .r = r};
     vec3 n, x = node_point(sn, k, &n);
     int prim = sn->prim_of[k];
     vec3 e;
+    *gathered = 0;
     if (level == 0) {
         e = zone_lights_at(&t, prim, x, n);
         if (f->sky)
             e = v3_add(e, zone_sky_irradiance(&t, x, n));
-    } else {
-        /* Far out on a plane a node stands for a wide cell that matters
-         * little: a coarser cut (the square root of its growth, as the
-         * texels had). */
-        transfer_ctx tk = *tc;
-        tk.eps = tc->eps * sqrt(sn->growth[k]);
+        *rays += t.rays;
+        return e;
+    }
+    /* Far out on a plane a node stands for a wide cell that matters
+     * little: a coarser limit (the square root of its growth, as the
+     * texels had). */
+    transfer_ctx tk = *tc;
+    tk.eps = tc->eps * sqrt(sn->growth[k]);
+    bounce_limit lim = {.eps = tk.eps, .lower = light_below(f, level, k), .floor = tc->floor};
+    *gathered = bounce_gather(&t, f->bounce_dirs, f->q.gather, x, n, level, &lim, &e);
+    if (!*gathered) {
         if (prim >= r->rs.part_count)
             tk.max_cut = f->mesh_gather ? tc->max_cut / GATHERED_MESH_CUT_DIV
                                         : tc->max_cut * MESH_CUT_NUM / MESH_CUT_DEN;
@@ -194,12 +213,13 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
         t.rays += ts.rays;
         *links += ts.clusters;
         *capped += ts.capped;
-        if (level == 1 && f->glint_count)
-            e = v3_add(e, glint_irradiance(&t, f->glint_spheres, f->glint_count, x, n,
-                                           f->q.glint_cuts));
-        if (f->need_gather)
-            e = v3_add(e, specular_gather(&t, x, n, level));
     }
+    if (level == 1 && f->glint_count)
+        e = v3_add(e, glint_irradiance(&t, f->glint_spheres, f->glint_count, x, n,
+                                       f->q.glint_cuts));
+    /* (A gather read the specular chains along its own rays.) */
+    if (!*gathered && f->need_gather)
+        e = v3_add(e, specular_gather(&t, x, n, level));
     *rays += t.rays;
     return e;
 }
@@ -318,7 +338,7 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
     float *v = calloc(3 * (size_t)sn->node_count + 3, sizeof(float));
     if (!v)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for level %d's node values", level);
-    uint64_t rays = 0, links = 0, capped = 0, cuts = 0, shared = 0;
+    uint64_t rays = 0, links = 0, capped = 0, cuts = 0, shared = 0, gathers = 0;
     int threads = render_thread_count(o->threads);
     const volatile sig_atomic_t *stop = o->stop;
     int quit = 0;
@@ -339,7 +359,7 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
 #pragma omp parallel num_threads(threads)
         {
             cut_record rec = {0};
-#pragma omp for schedule(dynamic, NODE_BLOCK) reduction(+ : rays, links, capped, cuts, shared)
+#pragma omp for schedule(dynamic, NODE_BLOCK) reduction(+ : rays, links, capped, cuts, shared, gathers)
             for (int k = 0; k < sn->node_count; k++) {
                 int q;
 #pragma omp atomic read
@@ -372,6 +392,7 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
                     continue;
                 vec3 e;
                 float read[3];
+                int gathered = 0;
                 rec.n = 0;
                 rec.failed = 1; /* until the leader's cut is kept */
                 if (twin >= 0) {
@@ -387,8 +408,9 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
                     /* (Members take the leader's cut below, or its value.) */
                     int keep = lead >= 0 && level < GROUP_COPY_LEVEL;
                     e = node_value(f, r, level, &tc, k, keep ? &rec : NULL, NULL, &rays, &links,
-                                   &capped);
-                    cuts += level > 0;
+                                   &capped, &gathered);
+                    cuts += level > 0 && !gathered;
+                    gathers += gathered;
                 }
                 set_value(v, k, e);
                 progress_add(&prog, 1.0);
@@ -396,11 +418,15 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
                     continue;
                 for (int32_t i = ng->first[k]; i < ng->first[k + 1]; i++) {
                     int32_t m = ng->member[i];
-                    if (level < GROUP_COPY_LEVEL) {
+                    /* A leader that gathered found its light smooth
+                     * there: its members take its value. */
+                    if (level < GROUP_COPY_LEVEL && !gathered) {
+                        int g = 0;
                         e = node_value(f, r, level, &tc, m, NULL, rec.failed ? NULL : &rec,
-                                       &rays, &links, &capped);
-                        cuts++;
-                        shared += !rec.failed;
+                                       &rays, &links, &capped, &g);
+                        cuts += !g;
+                        gathers += g;
+                        shared += !rec.failed && !g;
                     }
                     set_value(v, m, e);
                     progress_add(&prog, 1.0);
@@ -433,6 +459,7 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
     f->cuts += cuts;
     f->cuts_capped += capped;
     f->cuts_shared += shared;
+    f->gathers += gathers;
     return st;
 }
 
@@ -527,9 +554,9 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
     }
     if (share_ranks(&r->options) > 1) {
         /* The counts are the whole job's, as one process's would be. */
-        double n[5] = {(double)f->rays, (double)f->links, (double)f->cuts,
-                       (double)f->cuts_capped, (double)f->cuts_shared};
-        st = share_sum(&r->options, n, 5, err);
+        double n[6] = {(double)f->rays, (double)f->links, (double)f->cuts,
+                       (double)f->cuts_capped, (double)f->cuts_shared, (double)f->gathers};
+        st = share_sum(&r->options, n, 6, err);
         if (st != ZT_OK)
             return st;
         f->rays = (uint64_t)n[0];
@@ -537,6 +564,7 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
         f->cuts = (uint64_t)n[2];
         f->cuts_capped = (uint64_t)n[3];
         f->cuts_shared = (uint64_t)n[4];
+        f->gathers = (uint64_t)n[5];
     }
     return zone_forest_zones(f, r, err);
 }

@@ -1,0 +1,83 @@
+/* Gathering a level's light at a node (bounce_gather.h). */
+#include "zone/transfer/bounce_gather.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "geom/ray_offset.h"
+#include "util/sampler.h"
+#include "util/vec3_convert.h"
+
+#define PI 3.14159265358979323846
+/* The fewest directions whose spread says whether the rest are worth
+ * casting. */
+#define FIRST_MIN 16
+
+/* Sobol's second dimension: the direction numbers of x + 1, each the one
+ * before xor itself shifted by one. */
+static uint32_t sobol_second(uint32_t i)
+{
+    uint32_t r = 0, v = 1u << 31;
+    for (; i; i >>= 1, v ^= v >> 1)
+        if (i & 1)
+            r ^= v;
+    return r;
+}
+
+vec3 *bounce_directions(int n)
+{
+    vec3 *d = malloc((size_t)(n > 0 ? n : 1) * sizeof *d);
+    if (!d)
+        return NULL;
+    for (int i = 0; i < n; i++) {
+        double u1 = sampler_reverse_bits((uint32_t)i) * (1.0 / 4294967296.0);
+        double u2 = sobol_second((uint32_t)i) * (1.0 / 4294967296.0);
+        /* (Half a step up from 0: the first direction is not the normal
+         * exactly, which a grid's neighbour would hit edge-on.) */
+        u1 += 0.5 / n;
+        double r = sqrt(u1), phi = 2 * PI * u2;
+        d[i] = v3(r * cos(phi), r * sin(phi), sqrt(fmax(0.0, 1.0 - u1)));
+    }
+    return d;
+}
+
+static double lum(vec3 v)
+{
+    return 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
+}
+
+/* Whether the mean of `count` samples (sum s1, sum of squares s2) is known
+ * well enough for the whole gather of n_dirs. */
+static int good_enough(double s1, double s2, int count, int n_dirs, const bounce_limit *lim)
+{
+    double mean = s1 / count, var = fmax(0.0, s2 / count - mean * mean);
+    double err = PI * sqrt(var / n_dirs);
+    return err <= lim->eps * fmax(lim->lower + PI * mean, lim->floor);
+}
+
+int bounce_gather(zone_trace *t, const vec3 *dirs, int n_dirs, vec3 x, vec3 n, int level,
+                  const bounce_limit *lim, vec3 *e)
+{
+    vec3 tt, bb;
+    v3_frame(n, &tt, &bb);
+    vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
+    vec3 sum = v3(0, 0, 0);
+    double s1 = 0, s2 = 0;
+    int first = n_dirs / 4 >= FIRST_MIN ? n_dirs / 4 : n_dirs;
+    for (int k = 0; k < n_dirs; k++) {
+        if (k == first && !good_enough(s1, s2, k, n_dirs, lim))
+            return 0;
+        vec3 d = v3_add(v3_add(v3_scale(tt, dirs[k].x), v3_scale(bb, dirs[k].y)),
+                        v3_scale(n, dirs[k].z));
+        vec3 l = zone_radiance(t, o, v3_to_f3(v3_normalize(d)), level, level,
+                               ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0);
+        double y = lum(l);
+        s1 += y;
+        s2 += y * y;
+        sum = v3_add(sum, l);
+    }
+    if (!good_enough(s1, s2, n_dirs, n_dirs, lim))
+        return 0;
+    *e = v3_scale(sum, PI / n_dirs);
+    return 1;
+}
