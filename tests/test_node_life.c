@@ -156,11 +156,79 @@ static void test_raised_vertices_survive_the_forest_file(void **state)
     zt_scene_release(scene);
 }
 
+/* A box of 12 two-sided triangles standing on the floor, or the same box
+ * without its lid (open: a sheet light may reach under, like a roof seen
+ * from below).  The floor's nodes under the closed box see its faces from
+ * behind in every direction: dead, so the floor around its foot is read
+ * from the lit nodes outside (else it was darkened there, half way to the
+ * nodes under the box).  Under the open one they stay live, as before. */
+static int floor_nodes_under_box(int lid, int *under)
+{
+    static const double q[8][3] = {{0.5, 0, -1.5}, {2, 0, -1.5}, {2, 0, 0},   {0.5, 0, 0},
+                                   {0.5, 1.2, -1.5}, {2, 1.2, -1.5}, {2, 1.2, 0}, {0.5, 1.2, 0}};
+    /* Quads wound counter-clockwise seen from outside. */
+    static const int quad[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
+                                   {3, 2, 6, 7}, {0, 3, 7, 4}, {1, 5, 6, 2}};
+    char parts[4096];
+    size_t len = 0;
+    for (int f = 0; f < 6; f++) {
+        if (!lid && f == 1)
+            continue;
+        const int *c = quad[f];
+        for (int t = 0; t < 2; t++) {
+            int a = c[0], b = c[t + 1], d = c[t + 2];
+            len += (size_t)snprintf(parts + len, sizeof parts - len,
+                                    "%s{\"triangle\": {\"points\": [[%g, %g, %g], [%g, %g, %g], "
+                                    "[%g, %g, %g]]}}",
+                                    len ? "," : "", q[a][0], q[a][1], q[a][2], q[b][0], q[b][1],
+                                    q[b][2], q[d][0], q[d][1], q[d][2]);
+        }
+    }
+    char text[8192];
+    snprintf(text, sizeof text,
+             "{\"camera\": {\"position\": [6, 4, 7], \"lookat\": [0, 0.6, 0], \"fov\": 40, "
+             "\"gridresolution\": [8, 8]}, \"scene\": ["
+             "{\"sky\": {\"color\": [1, 1, 1]}},"
+             "{\"plane\": {\"normal\": [0, 1, 0], \"offset\": 0, " TEST_DIFFUSE(0.5) "}},"
+             "{\"thing\": {" TEST_DIFFUSE(0.6) ", \"parts\": [%s]}}]}",
+             parts);
+    zt_scene *scene = test_scene_text(text, "box_on_floor.json");
+    zt_renderer *r = test_zone_renderer(scene, 2, 2, zt_render_options_default().quality);
+    const surface_nodes *sn = &r->forest->sn;
+    int live = 0;
+    *under = 0;
+    for (int32_t k = 0; k < sn->node_count; k++) {
+        const float *x = sn->pos + 3 * (size_t)k;
+        /* The plane is part 0: its nodes, well inside the box's foot. */
+        if (sn->prim_of[k] != 0 || !(sn->nrm[3 * k + 1] > 0.5f) || !(x[0] > 0.6f) ||
+            !(x[0] < 1.9f) || !(x[2] > -1.4f) || !(x[2] < -0.1f))
+            continue;
+        (*under)++;
+        live += sn->live[k];
+    }
+    zt_renderer_release(r);
+    zt_scene_release(scene);
+    return live;
+}
+
+static void test_closed_box_hides_the_floor(void **state)
+{
+    (void)state;
+    int under, live = floor_nodes_under_box(1, &under);
+    printf("closed box: %d of the %d floor nodes under it live\n", live, under);
+    assert_true(under > 0);
+    assert_int_equal(live, 0);
+    live = floor_nodes_under_box(0, &under);
+    printf("open box: %d of the %d floor nodes under it live\n", live, under);
+    assert_int_equal(live, under);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sunk_vertices_are_raised),
         cmocka_unit_test(test_raised_vertices_survive_the_forest_file),
+        cmocka_unit_test(test_closed_box_hides_the_floor),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "render/prim.h"
+#include "zone/phase_one/closed_surfaces.h"
 #include "zone/light/zprim.h"
 
 #define PROBES 8
@@ -321,6 +322,8 @@ uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_s
                 walls[nw++] = q;
     double h = sn->h, seam = 1e-4 * h;
     uint64_t rays = 0;
+    closed_surfaces closed;
+    closed_surfaces_find(&closed, scene, rs);
 #pragma omp parallel for schedule(dynamic, 256) num_threads(threads) reduction(+ : rays)
     for (int k = 0; k < sn->node_count; k++) {
         if (!sn->live[k])
@@ -353,10 +356,13 @@ uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_s
                 int back = 0;
                 int hit = node_life_first_hit(occ, scene, rs, o, probe_dir(n, p), &back);
                 rays++;
-                /* Only a culled surface's back is a wall nothing passes:
-                 * the back of a two-sided one is a surface like any. */
+                /* Only the back of a culled or a closed surface is a wall
+                 * nothing passes: the back of an open two-sided one (a
+                 * sheet of roof) is a surface like any. */
                 rs_part hp;
-                inside += hit >= 0 && back && rs_prim(rs, hit, &hp)->culled;
+                inside += hit >= 0 && back &&
+                          (rs_prim(rs, hit, &hp)->culled ||
+                           closed_surfaces_has(&closed, scene, rs, hit));
             }
             dead = 2 * inside >= PROBES;
         }
@@ -366,6 +372,7 @@ uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_s
         sn->pos[3 * k + 2] = (float)x.z;
     }
     free(walls);
+    closed_surfaces_free(&closed);
     return rays + raise_sunk_vertices(sn, occ, scene, rs);
 }
 
