@@ -27,74 +27,99 @@ static int u64_cmp(const void *a, const void *b)
     return p < q ? -1 : p > q;
 }
 
-/* Whether n triangles, their corners' positions in pos (9 floats each),
- * close: corners at one position are one vertex, and every directed edge
- * appears once with its reverse once.  -1 when out of memory. */
-static int triangles_close(const float *pos, size_t n)
+static uint32_t root(uint32_t *up, uint32_t v)
 {
-    if (n < 4)
-        return 0;
+    while (up[v] != v) {
+        up[v] = up[up[v]];
+        v = up[v];
+    }
+    return v;
+}
+
+/* For n triangles, their corners' positions in pos (9 floats each): which
+ * lie on a closed piece, into closed[t].  Corners at one position are one
+ * vertex; triangles sharing a vertex are one piece; a piece is closed when
+ * each of its directed edges appears once and its reverse once.  0 when
+ * out of memory. */
+static int close_pieces(const float *pos, size_t n, uint8_t *closed)
+{
     size_t nc = 3 * n;
-    corner *c = malloc(nc * sizeof *c);
-    uint32_t *id = malloc(nc * sizeof *id);
-    uint64_t *edge = malloc(nc * sizeof *edge);
-    int closed = -1;
-    if (!c || !id || !edge)
-        goto done;
-    for (size_t i = 0; i < nc; i++) {
-        /* (+0 and -0 are one position.) */
-        for (int k = 0; k < 3; k++) {
-            float v = pos[3 * i + k] + 0.0f;
-            memcpy(&c[i].key[k], &v, sizeof v);
+    corner *c = malloc((nc ? nc : 1) * sizeof *c);
+    uint32_t *id = malloc((nc ? nc : 1) * sizeof *id);
+    uint32_t *up = malloc((nc ? nc : 1) * sizeof *up);
+    uint64_t *edge = malloc((nc ? nc : 1) * sizeof *edge);
+    uint8_t *bad = calloc(nc ? nc : 1, 1);
+    int ok = c && id && up && edge && bad;
+    if (ok) {
+        for (size_t i = 0; i < nc; i++) {
+            /* (+0 and -0 are one position.) */
+            for (int k = 0; k < 3; k++) {
+                float v = pos[3 * i + k] + 0.0f;
+                memcpy(&c[i].key[k], &v, sizeof v);
+            }
+            c[i].index = (uint32_t)i;
         }
-        c[i].index = (uint32_t)i;
-    }
-    qsort(c, nc, sizeof *c, corner_cmp);
-    uint32_t next = 0;
-    for (size_t i = 0; i < nc; i++) {
-        if (i > 0 && corner_cmp(&c[i], &c[i - 1]) != 0)
-            next++;
-        id[c[i].index] = next;
-    }
-    for (size_t t = 0; t < n; t++)
-        for (int k = 0; k < 3; k++) {
-            uint64_t a = id[3 * t + k], b = id[3 * t + (k + 1) % 3];
-            edge[3 * t + k] = a << 32 | b;
+        qsort(c, nc, sizeof *c, corner_cmp);
+        uint32_t next = 0;
+        for (size_t i = 0; i < nc; i++) {
+            if (i > 0 && corner_cmp(&c[i], &c[i - 1]) != 0)
+                next++;
+            id[c[i].index] = next;
         }
-    qsort(edge, nc, sizeof *edge, u64_cmp);
-    closed = 1;
-    for (size_t i = 0; i < nc && closed; i++) {
-        uint64_t a = edge[i] >> 32, b = edge[i] & 0xffffffffu, rev = b << 32 | a;
-        if (a == b || (i > 0 && edge[i] == edge[i - 1]) ||
-            !bsearch(&rev, edge, nc, sizeof *edge, u64_cmp))
-            closed = 0;
+        for (uint32_t v = 0; v <= next && v < nc; v++)
+            up[v] = v;
+        for (size_t t = 0; t < n; t++)
+            for (int k = 1; k < 3; k++) {
+                uint32_t a = root(up, id[3 * t]), b = root(up, id[3 * t + k]);
+                if (a != b)
+                    up[a < b ? b : a] = a < b ? a : b;
+            }
+        for (size_t t = 0; t < n; t++)
+            for (int k = 0; k < 3; k++) {
+                uint64_t a = id[3 * t + k], b = id[3 * t + (k + 1) % 3];
+                edge[3 * t + k] = a << 32 | b;
+            }
+        qsort(edge, nc, sizeof *edge, u64_cmp);
+        for (size_t i = 0; i < nc; i++) {
+            uint64_t a = edge[i] >> 32, b = edge[i] & 0xffffffffu, rev = b << 32 | a;
+            if (a == b || (i > 0 && edge[i] == edge[i - 1]) ||
+                (i + 1 < nc && edge[i] == edge[i + 1]) ||
+                !bsearch(&rev, edge, nc, sizeof *edge, u64_cmp))
+                bad[root(up, (uint32_t)a)] = 1;
+        }
+        for (size_t t = 0; t < n; t++)
+            closed[t] = !bad[root(up, id[3 * t])];
     }
-done:
     free(c);
     free(id);
+    free(up);
     free(edge);
-    return closed;
+    free(bad);
+    return ok;
 }
 
 int closed_surfaces_find(closed_surfaces *cs, const zt_scene *sc, const rscene *rs)
 {
-    cs->object = calloc((size_t)sc->object_count + 1, 1);
-    cs->mesh = calloc((size_t)rs->mesh_count + 1, 1);
+    int prims = rs->part_count;
+    for (int mi = 0; mi < rs->mesh_count; mi++) {
+        int end = rs->meshes[mi].prim_base + rs->meshes[mi].m->triangle_count;
+        prims = end > prims ? end : prims;
+    }
+    cs->prim = calloc((size_t)prims + 1, 1);
     int *count = calloc((size_t)sc->object_count + 1, sizeof *count);
-    int ok = cs->object && cs->mesh && count;
-    for (int i = 0; ok && i < sc->part_count; i++)
+    int ok = cs->prim && count;
+    for (int i = 0; ok && i < rs->part_count; i++)
         if (sc->parts[i].shape == SHAPE_TRIANGLE)
             count[sc->parts[i].object]++;
+    /* A thing's triangles, object by object. */
     for (int o = 0; ok && o < sc->object_count; o++) {
         if (count[o] < 4)
             continue;
         float *pos = malloc((size_t)count[o] * 9 * sizeof *pos);
-        if (!pos) {
-            ok = 0;
-            break;
-        }
+        uint8_t *closed = malloc((size_t)count[o]);
         size_t n = 0;
-        for (int i = 0; i < sc->part_count; i++) {
+        ok = pos && closed;
+        for (int i = 0; ok && i < rs->part_count; i++) {
             const part *p = &sc->parts[i];
             if (p->shape != SHAPE_TRIANGLE || p->object != o)
                 continue;
@@ -105,27 +130,25 @@ int closed_surfaces_find(closed_surfaces *cs, const zt_scene *sc, const rscene *
             }
             n++;
         }
-        int c = triangles_close(pos, n);
+        ok = ok && close_pieces(pos, n, closed);
+        for (int i = 0, t = 0; ok && i < rs->part_count; i++)
+            if (sc->parts[i].shape == SHAPE_TRIANGLE && sc->parts[i].object == o)
+                cs->prim[i] = closed[t++];
         free(pos);
-        ok = c >= 0;
-        cs->object[o] = c > 0;
+        free(closed);
     }
+    /* A mesh's, piece by piece. */
     for (int mi = 0; ok && mi < rs->mesh_count; mi++) {
         const mesh *m = rs->meshes[mi].m;
         size_t n = (size_t)m->triangle_count;
         float *pos = malloc((n ? n : 1) * 9 * sizeof *pos);
-        if (!pos) {
-            ok = 0;
-            break;
-        }
-        for (size_t t = 0; t < n; t++)
+        ok = pos != NULL;
+        for (size_t t = 0; ok && t < n; t++)
             for (int k = 0; k < 3; k++)
                 memcpy(&pos[9 * t + 3 * k], m->position + 3 * (size_t)m->index[3 * t + k],
                        3 * sizeof *pos);
-        int c = triangles_close(pos, n);
+        ok = ok && close_pieces(pos, n, cs->prim + rs->meshes[mi].prim_base);
         free(pos);
-        ok = c >= 0;
-        cs->mesh[mi] = c > 0;
     }
     free(count);
     if (!ok) {
@@ -136,18 +159,13 @@ int closed_surfaces_find(closed_surfaces *cs, const zt_scene *sc, const rscene *
     return 1;
 }
 
-int closed_surfaces_has(const closed_surfaces *cs, const zt_scene *sc, const rscene *rs, int prim)
+int closed_surfaces_has(const closed_surfaces *cs, int prim)
 {
-    if (!cs->object || !cs->mesh || prim < 0)
-        return 0;
-    if (prim < rs->part_count)
-        return cs->object[sc->parts[prim].object];
-    return cs->mesh[rs_mesh_of(rs, prim) - rs->meshes];
+    return cs->prim && prim >= 0 && cs->prim[prim];
 }
 
 void closed_surfaces_free(closed_surfaces *cs)
 {
-    free(cs->object);
-    free(cs->mesh);
-    cs->object = cs->mesh = NULL;
+    free(cs->prim);
+    cs->prim = NULL;
 }

@@ -1,6 +1,7 @@
-/* Which objects' triangles close around a volume: every edge shared by
- * exactly two of its triangles, once in each direction (a consistently
- * wound closed surface).  From outside such a surface only its front faces
+/* Which triangles lie on a closed piece of surface: a thing's triangles, or
+ * a mesh's, split into pieces that share vertices; a piece is closed when
+ * every edge of it is shared by exactly two of its triangles, once in each
+ * direction (a consistently wound closed surface).  From outside such a surface only its front faces
  * show, so a node that sees its back faces in most directions is inside it
  * (node_life.c), whether the surface is backculled or not: a box standing
  * on the floor hides the floor's nodes under it, which else were read with
@@ -15,15 +16,14 @@
 #include "scene/scene.h"
 
 typedef struct closed_surfaces {
-    uint8_t *object;    /* per scene object: its triangle parts are closed */
-    uint8_t *mesh;      /* per mesh of the render scene: its triangles are */
+    uint8_t *prim;      /* per primitive: on a closed piece */
 } closed_surfaces;
 
 /* Finds them; 0 when out of memory (then none is closed). */
 int closed_surfaces_find(closed_surfaces *cs, const zt_scene *sc, const rscene *rs);
 
 /* Whether primitive prim belongs to a closed surface. */
-int closed_surfaces_has(const closed_surfaces *cs, const zt_scene *sc, const rscene *rs, int prim);
+int closed_surfaces_has(const closed_surfaces *cs, int prim);
 
 void closed_surfaces_free(closed_surfaces *cs);
 

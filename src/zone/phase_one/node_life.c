@@ -362,7 +362,7 @@ uint64_t node_life_mark(surface_nodes *sn, const occluder_index *occ, const zt_s
                 rs_part hp;
                 inside += hit >= 0 && back &&
                           (rs_prim(rs, hit, &hp)->culled ||
-                           closed_surfaces_has(&closed, scene, rs, hit));
+                           closed_surfaces_has(&closed, hit));
             }
             dead = 2 * inside >= PROBES;
         }
