@@ -196,6 +196,27 @@ static void test_room_of_planes(void **state)
     zt_scene_release(s);
 }
 
+/* The mean green of level 2 at 1,024 spp (path, mean[0]) and from the zone
+ * tracer (mean[1]); the zone render's statistics into *zone_stats (if any). */
+static void level2_means(const zt_scene *s, double mean[2], zt_render_stats *zone_stats)
+{
+    for (int m = 0; m < 2; m++) {
+        zt_render_options o = zt_render_options_default();
+        o.method = m ? ZT_METHOD_ZONE : ZT_METHOD_PATH;
+        o.level = 2;
+        o.spp = 1024;
+        zt_image *img = NULL;
+        zt_error err = {0};
+        if (zt_render(s, &o, &img, m ? zone_stats : NULL, &err) != ZT_OK)
+            fail_msg("render: %s", err.message);
+        double sum = 0;
+        for (int i = 0; i < img->width * img->height; i++)
+            sum += img->pixels[3 * i + 1];
+        mean[m] = sum / (img->width * img->height);
+        zt_image_release(img);
+    }
+}
+
 /* A diffuse sphere floating over a ground plane under a point light: the
  * light the sphere's lit side sends onto the ground (level 2) reaches the
  * ground's nodes.  A sphere's sending cells are flat polygons between its
@@ -214,21 +235,7 @@ static void test_sphere_lights_the_ground(void **state)
         "{\"sphere\": {\"center\": [-1, 1.5, 0.5], \"radius\": 1, " TEST_DIFFUSE(0.7) "}}]}";
     zt_scene *s = test_scene_text(text, "sphere_over_ground");
     double mean[2];
-    for (int m = 0; m < 2; m++) {
-        zt_render_options o = zt_render_options_default();
-        o.method = m ? ZT_METHOD_ZONE : ZT_METHOD_PATH;
-        o.level = 2;
-        o.spp = 1024;
-        zt_image *img = NULL;
-        zt_error err = {0};
-        if (zt_render(s, &o, &img, NULL, &err) != ZT_OK)
-            fail_msg("render: %s", err.message);
-        double sum = 0;
-        for (int i = 0; i < img->width * img->height; i++)
-            sum += img->pixels[3 * i + 1];
-        mean[m] = sum / (img->width * img->height);
-        zt_image_release(img);
-    }
+    level2_means(s, mean, NULL);
     print_message("level 2 over the ground: zone %.4f, path %.4f (%+.2f%%)\n", mean[1], mean[0],
                   100 * (mean[1] / mean[0] - 1));
     assert_true(fabs(mean[1] / mean[0] - 1) < 0.03);
@@ -252,21 +259,7 @@ static void test_sky_bounce_gathered(void **state)
     zt_scene *s = test_scene_text(text, "sphere_under_sky");
     double mean[2];
     zt_render_stats st;
-    for (int m = 0; m < 2; m++) {
-        zt_render_options o = zt_render_options_default();
-        o.method = m ? ZT_METHOD_ZONE : ZT_METHOD_PATH;
-        o.level = 2;
-        o.spp = 1024;
-        zt_image *img = NULL;
-        zt_error err = {0};
-        if (zt_render(s, &o, &img, &st, &err) != ZT_OK)
-            fail_msg("render: %s", err.message);
-        double sum = 0;
-        for (int i = 0; i < img->width * img->height; i++)
-            sum += img->pixels[3 * i + 1];
-        mean[m] = sum / (img->width * img->height);
-        zt_image_release(img);
-    }
+    level2_means(s, mean, &st);
     print_message("level 2 under the sky: zone %.4f, path %.4f (%+.2f%%); %llu nodes gathered, "
                   "%llu cut\n",
                   mean[1], mean[0], 100 * (mean[1] / mean[0] - 1),

@@ -106,37 +106,46 @@ int closed_surfaces_find(closed_surfaces *cs, const zt_scene *sc, const rscene *
         prims = end > prims ? end : prims;
     }
     cs->prim = calloc((size_t)prims + 1, 1);
-    int *count = calloc((size_t)sc->object_count + 1, sizeof *count);
-    int ok = cs->prim && count;
+    /* A thing's triangle parts, grouped by object in one pass: first[o] ..
+     * first[o + 1] in `of`. */
+    int *first = calloc((size_t)sc->object_count + 1, sizeof *first);
+    int *fill = malloc(((size_t)sc->object_count + 1) * sizeof *fill);
+    int *of = malloc(((size_t)rs->part_count + 1) * sizeof *of);
+    int ok = cs->prim && first && fill && of;
     for (int i = 0; ok && i < rs->part_count; i++)
         if (sc->parts[i].shape == SHAPE_TRIANGLE)
-            count[sc->parts[i].object]++;
-    /* A thing's triangles, object by object. */
+            first[sc->parts[i].object + 1]++;
     for (int o = 0; ok && o < sc->object_count; o++) {
-        if (count[o] < 4)
+        first[o + 1] += first[o];
+        fill[o] = first[o];
+    }
+    for (int i = 0; ok && i < rs->part_count; i++)
+        if (sc->parts[i].shape == SHAPE_TRIANGLE)
+            of[fill[sc->parts[i].object]++] = i;
+    for (int o = 0; ok && o < sc->object_count; o++) {
+        int n = first[o + 1] - first[o];
+        if (n < 4)
             continue;
-        float *pos = malloc((size_t)count[o] * 9 * sizeof *pos);
-        uint8_t *closed = malloc((size_t)count[o]);
-        size_t n = 0;
+        float *pos = malloc((size_t)n * 9 * sizeof *pos);
+        uint8_t *closed = malloc((size_t)n);
         ok = pos && closed;
-        for (int i = 0; ok && i < rs->part_count; i++) {
-            const part *p = &sc->parts[i];
-            if (p->shape != SHAPE_TRIANGLE || p->object != o)
-                continue;
+        for (int t = 0; ok && t < n; t++) {
+            const part *p = &sc->parts[of[first[o] + t]];
             for (int k = 0; k < 3; k++) {
-                pos[9 * n + 3 * k] = (float)p->p[k].x;
-                pos[9 * n + 3 * k + 1] = (float)p->p[k].y;
-                pos[9 * n + 3 * k + 2] = (float)p->p[k].z;
+                pos[9 * t + 3 * k] = (float)p->p[k].x;
+                pos[9 * t + 3 * k + 1] = (float)p->p[k].y;
+                pos[9 * t + 3 * k + 2] = (float)p->p[k].z;
             }
-            n++;
         }
-        ok = ok && close_pieces(pos, n, closed);
-        for (int i = 0, t = 0; ok && i < rs->part_count; i++)
-            if (sc->parts[i].shape == SHAPE_TRIANGLE && sc->parts[i].object == o)
-                cs->prim[i] = closed[t++];
+        ok = ok && close_pieces(pos, (size_t)n, closed);
+        for (int t = 0; ok && t < n; t++)
+            cs->prim[of[first[o] + t]] = closed[t];
         free(pos);
         free(closed);
     }
+    free(first);
+    free(fill);
+    free(of);
     /* A mesh's, piece by piece. */
     for (int mi = 0; ok && mi < rs->mesh_count; mi++) {
         const mesh *m = rs->meshes[mi].m;
@@ -150,7 +159,6 @@ int closed_surfaces_find(closed_surfaces *cs, const zt_scene *sc, const rscene *
         ok = ok && close_pieces(pos, n, cs->prim + rs->meshes[mi].prim_base);
         free(pos);
     }
-    free(count);
     if (!ok) {
         /* Without memory none is closed: nodes live as they did. */
         closed_surfaces_free(cs);
