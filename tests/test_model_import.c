@@ -335,6 +335,9 @@ static void test_mtl_materials(void **state)
     assert_true(fabs(glass->mat.weight[LOBE_DIFFUSE] - 0.25) < 1e-6);
     assert_true(glass->mat.weight[LOBE_METALLIC] == 0 && glass->mat.weight[LOBE_REFLECTING] == 0);
     assert_true(fabs(glass->mat.ior - 1.33) < 1e-6);
+    /* MTL's dissolve is see-through: a pane, untinted (Kd is its surface's). */
+    assert_true(glass->mat.thin);
+    assert_true(glass->mat.tint.x == 1 && glass->mat.tint.y == 1 && glass->mat.tint.z == 1);
     assert_true(glass->emission.x == 0 && glass->emission.y == 0 && glass->emission.z == 0);
     /* Ke makes the lamp's triangle a light part. */
     assert_true(fabs(lamp->emission.x - 1) < 1e-6 && fabs(lamp->emission.y - 2) < 1e-6 &&

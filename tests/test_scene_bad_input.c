@@ -119,6 +119,8 @@ static const bad_case cases[] = {
     {"color_negative", WITH_MATERIAL("{\"character\": " CHARACTER("1", "0", "0", "0") ", \"color\": [-0.1, 1, 1]}"), 3, 0, "colour out of range"},
     {"ior_zero", WITH_MATERIAL("{\"character\": " CHARACTER("1", "0", "0", "0") ", \"color\": [1, 1, 1], \"refractiveindex\": 0}"), 3, 0, "refractiveindex must be positive"},
     {"ior_negative", WITH_MATERIAL("{\"character\": " CHARACTER("0", "0", "0", "1") ", \"color\": [1, 1, 1], \"refractiveindex\": -1.5}"), 3, 0, "refractiveindex must be positive"},
+    {"thin_without_glass", WITH_MATERIAL("{\"character\": " CHARACTER("1", "0", "0", "0") ", \"color\": [1, 1, 1], \"thin\": true}"), 3, 0, "weight is 0"},
+    {"thin_not_bool", WITH_MATERIAL("{\"character\": " CHARACTER("0", "0", "0", "1") ", \"color\": [1, 1, 1], \"thin\": \"yes\"}"), 3, 0, "true or false"},
     {"negative_emission", ITEM("{\"lightpoint\": {\"point\": [0, 0, 0], \"emission\": [1, -1, 1]}}"), 3, 53, "negative radiance"},
     {"negative_sky", ITEM("{\"sky\": {\"color\": [0, 0, -1]}}"), 3, 26, "negative radiance"},
     /* groups */

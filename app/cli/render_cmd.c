@@ -376,6 +376,9 @@ static void print_scene(const render_job *job)
     if (info.rough_materials)
         fprintf(stderr, "note: %d model materials have a roughness, which is ignored: "
                 "metal, mirror and glass lobes are smooth\n", info.rough_materials);
+    if (info.panes)
+        fprintf(stderr, "note: %d materials are thin panes: light crosses them undeviated "
+                "(docs/scene-format.md, \"thin\")\n", info.panes);
     if (info.missing_textures)
         fprintf(stderr, "note: %d model textures are missing or unreadable and were left "
                 "out (%s)\n", info.missing_textures, info.texture_problem);

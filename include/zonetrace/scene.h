@@ -62,6 +62,8 @@ typedef struct zt_scene_info {
                              cannot be decoded (left out: base colour only) */
     char texture_problem[160]; /* the first of them and why */
     int has_sky;      /* non-zero when a sky colour is given */
+    int panes;        /* materials (of things and of models' slots) whose
+                         refractive lobe is a thin pane */
 } zt_scene_info;
 
 void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out);

@@ -28,6 +28,12 @@ float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t)
     return 0.5f * (rs * rs + rp * rp);
 }
 
+float bsdf_pane_reflectance(float cos_i, float ior)
+{
+    float r = bsdf_fresnel_dielectric(cos_i, 1.0f, ior);
+    return 2.0f * r / (1.0f + r);
+}
+
 int bsdf_sample_material(const rs_object *m, const shading_frame *f, vec3f wo, float u_lobe,
                          float u_split, const float u2[2], float eta_i,
                          float eta_t, bsdf_sample *out)
@@ -63,7 +69,9 @@ int bsdf_sample_material(const rs_object *m, const shading_frame *f, vec3f wo, f
         return 1;
     default: {
         float f = bsdf_fresnel_dielectric(cos_o, eta_i, eta_t);
-        if (u_split < f) {
+        /* A pane's vertex is its reflection: passing is not scattering
+         * (the path tracer takes it before the vertex). */
+        if (m->thin || u_split < f) {
             out->wi = reflect(wo, n);
             out->weight = m->color;
             return 1;

@@ -72,6 +72,20 @@ float bsdf_schlick(float cos_i, float ior);
  * eta_i into eta_t; 1 under total internal reflection. */
 float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t);
 
+/* A thin pane (a material with "thin": its refractive lobe is a sheet of
+ * glass): the light it reflects at cosine cos_i, both faces and their
+ * inter-reflections counted, R = 2 r / (1 + r) for one face's r.  What it
+ * does not reflect crosses it undeviated. */
+float bsdf_pane_reflectance(float cos_i, float ior);
+
+/* The part of light that crosses a pane-carrying material undeviated at
+ * cosine cos_i: refractive weight x (1 - R) x tint. */
+static inline vec3f bsdf_pane_transmittance(const rs_object *m, float cos_i)
+{
+    return f3_scale(m->tint, m->weight[LOBE_REFRACTIVE] *
+                                 (1.0f - bsdf_pane_reflectance(cos_i, m->ior)));
+}
+
 /* Samples the material at a point with frame f (f->n facing the side of
  * wo, the direction towards the previous vertex).  u_lobe picks the lobe,
  * u_split reflection or transmission of the dielectric, u2 the diffuse

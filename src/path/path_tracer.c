@@ -14,6 +14,7 @@
 #include "geom/accel.h"
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
+#include "geom/transmittance.h"
 #include "light/distant.h"
 #include "light/light_sample.h"
 #include "material/bsdf.h"
@@ -21,6 +22,8 @@
 #include "util/sampler.h"
 
 #define MEDIUM_STACK 8
+/* Panes one path segment may cross (a stuck ray cannot loop). */
+#define PANES_MAX 32
 #define RR_START 3
 /* Sampler dimension pairs: 0 is the pixel position; each scattering vertex
  * uses PAIRS_PER_VERTEX after it (light point, BSDF direction). */
@@ -77,6 +80,8 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
     int prev_delta = 1;       /* the camera counts as a delta vertex */
     float prev_pdf = 0.0f;
     vec3f prev_x = o;
+    float seg_t = 0.0f;       /* distance from prev_x to o, across panes */
+    int panes = 0;
     media med;
     med.n = 0; /* obj[] is read only below n */
     sampler_stream rng = sampler_stream_start(px->key, index);
@@ -109,18 +114,38 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 vec3f le = light_emitted(rs, p, x, d);
                 float w = 1.0f;
                 if (!prev_delta && p->select_pdf > 0.0f)
-                    w = power_heuristic(prev_pdf, light_pdf(p, prev_x, d, h.t));
+                    w = power_heuristic(prev_pdf, light_pdf(p, prev_x, d, seg_t + h.t));
                 radiance = f3_add(radiance, f3_scale(f3_mul(beta, le), w));
             }
             break; /* lights absorb what reaches them */
+        }
+        const rs_object *m = &rs->objects[p->object];
+        vec3f ng = shape_normal(p, x);
+        vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
+        /* A pane passes the light it does not reflect undeviated: not a
+         * scattering event (the level, the MIS state and the segment's
+         * start stay), chosen with its probability so the weight is the
+         * tint.  Otherwise the vertex is the rest of the material, its
+         * weights renormalised, the pane's lobe reflecting only. */
+        float pane_keep = 1.0f, pane_r = 0.0f;
+        if (__builtin_expect(m->thin, 0)) {
+            float c = -f3_dot(n, d);
+            pane_r = bsdf_pane_reflectance(c, m->ior);
+            float p_pass = m->weight[LOBE_REFRACTIVE] * (1.0f - pane_r);
+            if (sampler_next(&rng) < p_pass) {
+                beta = f3_mul(beta, m->tint);
+                if (f3_is_black(beta) || ++panes > PANES_MAX)
+                    break;
+                o = ray_offset(x, f3_neg(n));
+                seg_t += h.t;
+                continue;
+            }
+            pane_keep = 1.0f - p_pass;
         }
         if (k >= pp->max_level)
             break;
         k++;
 
-        const rs_object *m = &rs->objects[p->object];
-        vec3f ng = shape_normal(p, x);
-        vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
         vec3f wo = f3_neg(d);
         /* Meshes: the shading normal ns (the geometric n still decides
          * sides) and a textured albedo, in a copy of the material. */
@@ -137,6 +162,19 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 textured.color = sh.albedo;
                 m = &textured;
             }
+        }
+        rs_object pane_vertex;
+        if (__builtin_expect(m->thin, 0)) {
+            pane_vertex = *m;
+            float inv = 1.0f / pane_keep;
+            int lobes = 0;
+            for (int l = 0; l < LOBE_COUNT; l++) {
+                float w = l == LOBE_REFRACTIVE ? m->weight[l] * pane_r : m->weight[l];
+                pane_vertex.weight[l] = w * inv;
+                lobes += w > 0.0f;
+            }
+            pane_vertex.lobe_choice = lobes > 1;
+            m = &pane_vertex;
         }
         uint32_t pair = 1 + (uint32_t)(k - 1) * PAIRS_PER_VERTEX;
         int nee = k >= pp->min_level && m->weight[LOBE_DIFFUSE] > 0.0f;
@@ -174,11 +212,14 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 vec3f to_y = f3_sub(f3_madd(x, ls.wi, ls.dist), x_out);
                 float dist_y = f3_length(to_y);
                 vec3f dir_y = f3_scale(to_y, 1.0f / dist_y);
-                if (!accel_occluded(rs, x_out, dir_y, dist_y * 0.9999f, lp->background)) {
+                vec3f tr = accel_transmittance(rs, x_out, dir_y, dist_y * 0.9999f,
+                                               lp->background);
+                if (!f3_is_black(tr)) {
                     float w_over_pdf = ls.delta ? 1.0f / ls.pdf
                                                 : power_heuristic_over(ls.pdf, bsdf_pdf);
                     radiance = f3_add(radiance,
-                                      f3_scale(f3_mul(f3_mul(beta, fcos), ls.li), w_over_pdf));
+                                      f3_scale(f3_mul(f3_mul(f3_mul(beta, fcos), ls.li), tr),
+                                               w_over_pdf));
                 }
             }
         }
@@ -200,9 +241,10 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 if (bsdf_pdf > 0.0f && !f3_is_black(li)) {
                     n_rays++;
                     /* Escaping means meeting nothing, background included. */
-                    if (!accel_occluded(rs, x_out, wi, FLT_MAX, 1))
+                    vec3f tr = accel_transmittance(rs, x_out, wi, FLT_MAX, 1);
+                    if (!f3_is_black(tr))
                         radiance = f3_add(radiance,
-                                          f3_scale(f3_mul(f3_mul(beta, fcos), li),
+                                          f3_scale(f3_mul(f3_mul(f3_mul(beta, fcos), li), tr),
                                                    power_heuristic_over(far_pdf, bsdf_pdf)));
                 }
             }
@@ -256,6 +298,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         prev_delta = bs.delta;
         prev_pdf = bs.pdf;
         prev_x = x;
+        seg_t = 0.0f;
         d = bs.wi;
 
         /* Russian roulette: a path whose throughput has fallen below 1

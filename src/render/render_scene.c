@@ -44,6 +44,8 @@ static void fill_object(rs_object *ro, const material *mat, vec3 emission, int i
     ro->lobe_choice = lobes > 1;
     ro->color = v3_to_f3(mat->color);
     ro->ior = (float)mat->ior;
+    ro->thin = (uint8_t)(mat->thin && mat->weight[LOBE_REFRACTIVE] > 0);
+    ro->tint = v3_to_f3(mat->tint);
     ro->is_light = (uint8_t)is_light;
     ro->culled = (uint8_t)o->backculled;
     ro->background = (uint8_t)o->background;
@@ -186,6 +188,8 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
         fill_object(&rs->objects[i], &o->mat, on ? o->emission : v3(0, 0, 0), o->is_light, o);
     }
     rs->object_count = build_meshes(rs, scene, lights_off, lights_off_count);
+    for (int i = 0; i < rs->object_count; i++)
+        rs->pane_count += rs->objects[i].thin;
 
     double total = 0;
     for (int i = 0; i < scene->part_count; i++) {

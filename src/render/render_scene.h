@@ -43,6 +43,8 @@ typedef struct rs_object {
     uint8_t background;
     uint8_t lobe_choice; /* more than one lobe has weight: choosing takes a
                             random number */
+    uint8_t thin;       /* the refractive lobe is a pane (bsdf_pane) */
+    vec3f tint;         /* a pane's transmission colour */
     const struct mesh_texture *texture; /* base colour, times color; NULL */
 } rs_object;
 
@@ -109,6 +111,8 @@ typedef struct rscene {
     int object_count;
     rs_light *lights;   /* parts sampled by next-event estimation */
     int light_count;
+    int pane_count;     /* objects with a thin refractive lobe: visibility
+                           queries then see through them (accel.h) */
     int *point_lights;  /* point-light parts, switched off or not */
     int point_light_count;
     /* Infinite planes of each layer ([0] foreground, [1] background), kept

@@ -1,4 +1,5 @@
-/* Materials: the four lobe weights, the albedo and the refractive index. */
+/* Materials: the four lobe weights, the albedo, the refractive index and
+ * whether the refractive lobe is a thin pane. */
 #include "scene/scene_reader.h"
 
 #include <math.h>
@@ -39,7 +40,7 @@ static zt_status load_character(load_ctx *ctx, jref ref, double *weight)
 zt_status load_material(load_ctx *ctx, jref ref, material *out)
 {
     static const char *const keys[] = {
-        "character", "color", "refractiveindex", NULL
+        "character", "color", "refractiveindex", "thin", NULL
     };
     material m = material_default();
     if (load_object(ctx, ref, "material") ||
@@ -57,6 +58,17 @@ zt_status load_material(load_ctx *ctx, jref ref, material *out)
             return load_fail(ctx, ior, "refractiveindex must be positive, not %g",
                              m.ior);
     }
+    jref thin = jref_member(ref.value, "thin");
+    if (thin.value) {
+        if (load_bool(ctx, thin, &m.thin))
+            return ZT_ERR_PARSE;
+        if (m.thin && m.weight[LOBE_REFRACTIVE] <= 0)
+            return load_fail(ctx, thin,
+                             "thin makes the refractive lobe a pane, but its weight is 0");
+    }
+    /* A hand-written pane is tinted by the material's colour, as the
+     * smooth refractive lobe is. */
+    m.tint = m.color;
     *out = m;
     return ZT_OK;
 }

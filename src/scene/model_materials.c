@@ -241,20 +241,32 @@ static void map_material(const struct aiMaterial *am, int gltf, mesh_slot *s)
     s->mat.color = v3(clamp01(color.x), clamp01(color.y), clamp01(color.z));
 
     double metallic = 0.0, transmission = 0.0, ior = GLASS_IOR, v;
+    int thin = 0;
     if (get_float(am, AI_MATKEY_METALLIC_FACTOR, &v))
         metallic = clamp01(v);
-    if (get_float(am, AI_MATKEY_TRANSMISSION_FACTOR, &v))
+    if (get_float(am, AI_MATKEY_TRANSMISSION_FACTOR, &v)) {
         transmission = clamp01(v);
-    /* MTL's dissolve arrives as opacity.  glTF's base-colour alpha arrives
-     * there too, but means coverage (alpha blending), not glass: ignored. */
-    else if (!gltf && get_float(am, AI_MATKEY_OPACITY, &v))
+        /* glTF: transmission without a volume's thickness is thin-walled. */
+        thin = !(get_float(am, AI_MATKEY_VOLUME_THICKNESS_FACTOR, &v) && v > 0.0);
+    }
+    /* MTL's dissolve and IFC's transparency arrive as opacity: see-through
+     * surfaces, not refracting solids, so panes (the thing behind is seen
+     * undistorted).  glTF's base-colour alpha arrives there too, but means
+     * coverage (alpha blending), not glass: ignored. */
+    else if (!gltf && get_float(am, AI_MATKEY_OPACITY, &v)) {
         transmission = 1.0 - clamp01(v);
+        thin = 1;
+    }
     if (get_float(am, AI_MATKEY_REFRACTI, &v) && v >= 1.0 && v <= 4.0)
         ior = v;
     s->mat.weight[LOBE_METALLIC] = metallic;
     s->mat.weight[LOBE_REFRACTIVE] = (1.0 - metallic) * transmission;
     s->mat.weight[LOBE_DIFFUSE] = (1.0 - metallic) * (1.0 - transmission);
     s->mat.weight[LOBE_REFLECTING] = 0.0;
+    /* A pane's light crosses it untinted: the file's colour is its
+     * surface's (the diffuse part), as a viewer blends it. */
+    s->mat.thin = thin && transmission > 0.0;
+    s->mat.tint = v3(1, 1, 1);
     /* One index serves both the metallic lobe's Fresnel term and glass. */
     s->mat.ior = s->mat.weight[LOBE_REFRACTIVE] > 0.0 ? ior : metallic > 0.0 ? METAL_IOR : ior;
 
@@ -294,6 +306,7 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
         m->slots[s].mat.weight[LOBE_DIFFUSE] = 1.0;
         m->slots[s].mat.color = v3(0.8, 0.8, 0.8);
         m->slots[s].mat.ior = 1.0;
+        m->slots[s].mat.tint = v3(1, 1, 1);
         m->slots[s].texture = -1;
     }
     char folder[4096];

@@ -97,6 +97,7 @@ material material_default(void)
     memset(&m, 0, sizeof m);
     m.weight[LOBE_DIFFUSE] = 1.0;
     m.ior = 1.0;
+    m.tint = v3(1, 1, 1);
     return m;
 }
 
@@ -160,6 +161,7 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
     }
     for (int i = 0; i < scene->object_count; i++) {
         const object *o = &scene->objects[i];
+        out->panes += o->mesh < 0 && o->mat.thin;
         if (o->mesh < 0)
             continue;
         const struct mesh *m = scene->meshes[o->mesh];
@@ -168,6 +170,8 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
         out->skipped_triangles += m->skipped_degenerate;
         out->replaced_normals += m->replaced_normals;
         out->rough_materials += m->rough_slots;
+        for (int s = 0; s < m->slot_count; s++)
+            out->panes += m->slots[s].mat.thin;
         if (m->missing_textures && !out->missing_textures)
             snprintf(out->texture_problem, sizeof out->texture_problem, "%s", m->texture_problem);
         out->missing_textures += m->missing_textures;

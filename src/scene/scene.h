@@ -19,6 +19,9 @@ typedef struct material {
     double weight[LOBE_COUNT]; /* each in [0,1], summing to 1 */
     vec3 color;                /* albedo of every lobe, each channel in [0,1] */
     double ior;                /* "refractiveindex", > 0, default 1 */
+    int thin;                  /* the refractive lobe is a thin pane: light
+                                  crosses it undeviated (docs/light-transport.md) */
+    vec3 tint;                 /* a pane's transmission colour */
 } material;
 
 typedef enum part_shape {

@@ -532,7 +532,8 @@ zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *
         z->power = r_f32(&rb);
         int limit = kind == ZONE_EMIT ? r->rs.prim_count : surfaces;
         if (kind < 0 || kind >= ZONE_KINDS || level < 0 || level > 255 || z->source < 0 ||
-            z->source >= limit || (kind == ZONE_EMIT) != (level == 0) || !(z->power >= 0)) {
+            z->source >= limit || (kind == ZONE_EMIT && level != 0) ||
+            (level == 0 && kind != ZONE_EMIT && kind != ZONE_REFRACT) || !(z->power >= 0)) {
             st = corrupt(err, path, "bad zone");
             goto done;
         }

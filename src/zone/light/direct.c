@@ -3,6 +3,8 @@
 #include <string.h>
 
 #include "geom/accel.h"
+#include "geom/transmittance.h"
+#include "render/prim.h"
 #include "geom/ray_offset.h"
 #include "util/vec3_convert.h"
 #include "zone/light/lambert.h"
@@ -398,13 +400,23 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
     shadow_region(&lpp, f, x, set, &region, &fr);
     /* Infinite planes are few and in no index. */
     for (int i = 0; i < sc->part_count; i++)
-        if (i != receiver && i != light && sc->parts[i].shape == SHAPE_PLANE &&
-            occlude_by(c, i, &lpp, f, x, n, &fr, set, scratch))
-            return 0;
+        if (i != receiver && i != light && sc->parts[i].shape == SHAPE_PLANE) {
+            if (c->rs->objects[c->rs->parts[i].object].thin)
+                return -1;
+            if (occlude_by(c, i, &lpp, f, x, n, &fr, set, scratch))
+                return 0;
+        }
     int32_t cand[DIRECT_MAX_OCCLUDERS];
     int found = occluders_query(c->occ, &region, cand, DIRECT_MAX_OCCLUDERS);
     if (found > DIRECT_MAX_OCCLUDERS)
         return -1;
+    /* A pane lets part of the light through: not a shadow that clipping
+     * can draw, so its points take rays (which see through it). */
+    for (int k = 0; k < found && c->rs->pane_count; k++) {
+        rs_part tmp;
+        if (c->rs->objects[rs_prim(c->rs, cand[k], &tmp)->object].thin)
+            return -1;
+    }
     for (int k = 0; k < found; k++)
         if (cand[k] != receiver && cand[k] != light &&
             occlude_by(c, cand[k], &lpp, f, x, n, &fr, set, scratch))
@@ -492,8 +504,8 @@ static int clips_every_point(const direct_ctx *c)
  * the centre of their quarter s (corner s, or the middle for 4): four
  * points with splits 1..4 side by side see, between them, the centres of the
  * finer triangles. */
-static double by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, const poly2 *p,
-                      vec3 x, vec3 n, int count, int split)
+static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, const poly2 *p,
+                    vec3 x, vec3 n, int count, int split)
 {
     /* Fan triangles, each cut into 4^k by midpoints. */
     int fan = p->n - 2, k = 0;
@@ -507,10 +519,12 @@ static double by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f
     vec3f xo = ray_offset(v3_to_f3(x), v3_to_f3(n));
     /* First every piece's ray; then Lambert's formula over the seen pieces
      * or, when most are seen, over the whole polygon less the hidden ones:
-     * the formula costs more than a ray, and most points see all or none. */
-    unsigned char seen[BY_RAYS_KEPT];
-    int keep = pieces <= BY_RAYS_KEPT, seen_count = 0, at = 0;
-    double e = 0;
+     * the formula costs more than a ray, and most points see all or none.
+     * A ray's result is 1 or 0, or by colour what panes let through. */
+    vec3f seen[BY_RAYS_KEPT];
+    int keep = pieces <= BY_RAYS_KEPT, at = 0;
+    double seen_count = 0;
+    vec3 e = v3(0, 0, 0);
     fan_walk w;
     vec3 q[3];
     fan_start(&w, f, p, m);
@@ -522,38 +536,43 @@ static double by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f
             ctr = v3_add(v3_scale(ctr, 0.5), v3_scale(q[split - 1], 0.5));
         vec3f to = f3_sub(v3_to_f3(ctr), xo);
         float dist = f3_length(to);
-        int s = 0;
+        vec3f s = f3_splat(0.0f);
         if (dist > 0.0f) {
             vec3f d = f3_scale(to, 1.0f / dist);
             if (lp->shape == SHAPE_SPHERE)
                 dist = sphere_entry(lp, xo, d, dist);
-            s = !accel_occluded(c->rs, xo, d, dist * 0.9999f, lp->background);
+            s = accel_transmittance(c->rs, xo, d, dist * 0.9999f, lp->background);
         }
         if (keep)
-            seen[at++] = (unsigned char)s;
-        else if (s)
-            e += lambert_polygon(x, n, q, 3);
-        seen_count += s;
+            seen[at++] = s;
+        else if (!f3_is_black(s))
+            e = v3_add(e, v3_mul(f3_to_v3(s), v3_splat(lambert_polygon(x, n, q, 3))));
+        seen_count += f3_max(s);
     }
     if (!keep)
         return e;
     if (seen_count == 0)
-        return 0;
+        return e;
     int by_hidden = 2 * seen_count > pieces;
     if (by_hidden) {
         vec3 whole[POLY2_MAX];
         for (int i = 0; i < p->n; i++)
             whole[i] = lift(f, p->x[i], p->y[i]);
-        e = lambert_polygon(x, n, whole, p->n);
+        e = v3_splat(lambert_polygon(x, n, whole, p->n));
     }
     at = 0;
     fan_start(&w, f, p, m);
-    while (fan_next(&w, q))
-        if (seen[at++] != by_hidden) {
+    while (fan_next(&w, q)) {
+        /* By the hidden ones, each takes away what it does not pass. */
+        vec3 s = f3_to_v3(seen[at++]);
+        vec3 part = by_hidden ? v3_sub(v3_splat(1.0), s) : s;
+        if (part.x > 0 || part.y > 0 || part.z > 0) {
             double g = lambert_polygon(x, n, q, 3);
-            e += by_hidden ? -g : g;
+            vec3 pg = v3(part.x * g, part.y * g, part.z * g);
+            e = by_hidden ? v3_sub(e, pg) : v3_add(e, pg);
         }
-    return e > 0 ? e : 0;
+    }
+    return v3(e.x > 0 ? e.x : 0, e.y > 0 ? e.y : 0, e.z > 0 ? e.z : 0);
 }
 
 double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
@@ -565,6 +584,13 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
 double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
                                int split)
 {
+    vec3 e = direct_irradiance_rgb(c, light, x, n, receiver, split);
+    return e.x == e.y && e.y == e.z ? e.x : (e.x + e.y + e.z) / 3.0;
+}
+
+vec3 direct_irradiance_rgb(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
+                           int split)
+{
     zprim lpp;
     light_prim(c, light, x, &lpp);
     const zprim *lp = &lpp;
@@ -573,26 +599,25 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
         vec3 d = v3_sub(lp->p[0], x);
         double d2 = v3_dot(d, d), cosx = v3_dot(n, d) / sqrt(d2);
         if (cosx <= 0)
-            return 0;
+            return v3(0, 0, 0);
         vec3f xf = f3((float)x.x, (float)x.y, (float)x.z);
         vec3f nf = f3((float)n.x, (float)n.y, (float)n.z);
         vec3f df = f3((float)d.x, (float)d.y, (float)d.z);
         float dist = f3_length(df);
-        if (accel_occluded(c->rs, ray_offset(xf, nf), f3_scale(df, 1.0f / dist),
-                           dist * 0.9999f, lp->background))
-            return 0;
-        return cosx / d2;
+        vec3f s = accel_transmittance(c->rs, ray_offset(xf, nf), f3_scale(df, 1.0f / dist),
+                                      dist * 0.9999f, lp->background);
+        return v3(s.x * cosx / d2, s.y * cosx / d2, s.z * cosx / d2);
     }
 
     light_frame f;
     poly2 pieces[MAX_PIECES], scratch;
     poly2_set set = {pieces, 1, MAX_PIECES, 0};
     if (!light_polygon(c, light, x, &f, &pieces[0]))
-        return 0;
+        return v3(0, 0, 0);
     /* Above x's horizon only. */
     poly2_clip(&pieces[0], v3_dot(n, f.u), v3_dot(n, f.v), v3_dot(n, v3_sub(f.origin, x)));
     if (pieces[0].n < 3)
-        return 0;
+        return v3(0, 0, 0);
     poly2 whole = pieces[0];
     /* Split points are only taken where shadows are busy, and there the
      * search nearly always finds too many: it is skipped (direct.h). */
@@ -602,7 +627,7 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
     if (cut < 0)
         return by_rays(c, lp, &f, &whole, x, n, c->fallback, split);
     if (cut == 0)
-        return 0;
+        return v3(0, 0, 0);
     double e = 0;
     for (int k = 0; k < set.count; k++) {
         const poly2 *p = &set.piece[k];
@@ -613,7 +638,7 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
             q[i] = lift(&f, p->x[i], p->y[i]);
         e += lambert_polygon(x, n, q, p->n);
     }
-    return e;
+    return v3_splat(e);
 }
 
 int direct_by_rays(const direct_ctx *c, int light, vec3 x, vec3 n)

@@ -58,6 +58,11 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
 double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
                                int split);
 
+/* The same by colour: panes on the way (a material with "thin") pass
+ * their tint.  Without panes the three channels are the value above. */
+vec3 direct_irradiance_rgb(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
+                           int split);
+
 /* Whether direct_irradiance sees light part `light` from x by rays (too
  * many occluders to clip): where a shadow is that busy, it may change
  * within a pixel. */

@@ -194,6 +194,19 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     vec3 color = f3_to_v3(m->color);
     if (k >= 1 && !glint && m->weight[LOBE_DIFFUSE] > 0.0f)
         deposit_at(t, h.part, k, back, f3_to_v3(xf), flux);
+    double cmax = v3_max(color);
+    if (m->thin) {
+        /* A pane passes flux on undeviated and at the same count of
+         * events: after none, that is direct light, which the direct
+         * light's rays see through the pane already. */
+        float cos_p = -f3_dot(nf, d);
+        vec3 pass = v3_scale(f3_to_v3(m->tint),
+                             m->weight[LOBE_REFRACTIVE] * (1.0 - bsdf_pane_reflectance(cos_p, m->ior)));
+        double sp = share * v3_max(pass);
+        if (k >= 1 && sp >= BRANCH_MIN)
+            follow(t, ray_offset(xf, f3_neg(nf)), d, v3_mul(flux, pass), sp, k, 0, NULL, media,
+                   media_count);
+    }
     /* The next surface would receive k + 1 events: only while a map level
      * is left for it. */
     if (k + 1 >= t->f->map_levels || k + 1 > LEVEL_MAX)
@@ -212,12 +225,13 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     int entering = media_count == 0 || media[media_count - 1] != p->object;
     float eta_i = media_count ? rs->objects[media[media_count - 1]].ior : 1.0f;
     float eta_t = entering ? m->ior : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
-    if (wt > 0.0f) {
+    if (wt > 0.0f && m->thin) {
+        k_refl += wt * bsdf_pane_reflectance(cos_o, m->ior);
+    } else if (wt > 0.0f) {
         float fr = bsdf_fresnel_dielectric(cos_o, eta_i, eta_t);
         k_refl += wt * fr;
         k_tran = wt * (1.0 - fr);
     }
-    double cmax = v3_max(color);
     if (k_refl > 0 && share * k_refl * cmax >= BRANCH_MIN) {
         int g = k == 0 && !back && media_count == 0 && glint_sphere(rs, h.part);
         follow(t, ray_offset(xf, nf), refl, v3_scale(v3_mul(flux, color), k_refl),

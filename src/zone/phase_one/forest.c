@@ -373,10 +373,11 @@ static void light_leaf(void *user, int i, vec3 x, vec3 n, double acc[3], cut_sta
                          el->n[2] * (x.z - el->c[2])) <= 0)
         return;
     const float *em = &f->light_tree.elem_radiance[3 * (size_t)i];
-    double g = direct_irradiance_split(&f->direct, el->prim, x, n, lc->receiver,
-                                       lc->t->light_split);
-    for (int ch = 0; ch < 3; ch++)
-        acc[ch] += g * em[ch];
+    vec3 g = direct_irradiance_rgb(&f->direct, el->prim, x, n, lc->receiver,
+                                   lc->t->light_split);
+    acc[0] += g.x * em[0];
+    acc[1] += g.y * em[1];
+    acc[2] += g.z * em[2];
 }
 
 /* The sun's direct irradiance at x, exactly (direct.h). */
@@ -385,8 +386,8 @@ static vec3 sun_at(zone_trace *t, int receiver, vec3 x, vec3 n)
     const rs_distant *d = &t->r->rs.distant;
     if (!d->sun)
         return v3(0, 0, 0);
-    double g = direct_irradiance_split(&t->f->direct, DIRECT_SUN, x, n, receiver, t->light_split);
-    return v3_scale(f3_to_v3(d->sun_radiance), g);
+    vec3 g = direct_irradiance_rgb(&t->f->direct, DIRECT_SUN, x, n, receiver, t->light_split);
+    return v3_mul(f3_to_v3(d->sun_radiance), g);
 }
 
 vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n)
@@ -409,8 +410,8 @@ vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n)
         vec3f em = rs->objects[lp->object].emission;
         if (f3_is_black(em))
             continue;
-        double g = direct_irradiance_split(&t->f->direct, prim, x, n, receiver, t->light_split);
-        e = v3_add(e, v3_scale(f3_to_v3(em), g));
+        vec3 g = direct_irradiance_rgb(&t->f->direct, prim, x, n, receiver, t->light_split);
+        e = v3_add(e, v3_mul(f3_to_v3(em), g));
     }
     return e;
 }
@@ -541,8 +542,9 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
         level_power[0] += z.power;
         ok = push_zone(f, z);
     }
-    /* One zone per surface, lobe and level above. */
-    for (int level = 1; level <= depth && ok; level++) {
+    /* One zone per surface, lobe and level above; a pane's from level 0
+     * (the light seen through it). */
+    for (int level = 0; level <= depth && ok; level++) {
         for (int s = 0; s < ns && ok; s++) {
             if (!present[s])
                 continue;
@@ -550,15 +552,21 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
             if (o->is_light)
                 continue;
             for (int k = 0; k < LOBE_COUNT && ok; k++) {
-                if (o->weight[k] <= 0.0f)
+                int pane = k == LOBE_REFRACTIVE && o->thin;
+                if (o->weight[k] <= 0.0f || (level == 0 && !pane))
                     continue;
-                double arriving = level - 1 < f->map_levels
-                                      ? flux[(size_t)(level - 1) * ns + s]
-                                      : level_power[level - 1];
-                /* A specular lobe passes on whatever arrives: bounded by
-                 * all the light of the level below. */
-                if (k != LOBE_DIFFUSE)
+                double arriving;
+                if (pane)
+                    /* It passes its own level on: bounded by the light of
+                     * level 0, as every level is. */
+                    arriving = level_power[0];
+                else if (k != LOBE_DIFFUSE)
+                    /* A specular lobe passes on whatever arrives: bounded
+                     * by all the light of the level below. */
                     arriving = level_power[level - 1];
+                else
+                    arriving = level - 1 < f->map_levels ? flux[(size_t)(level - 1) * ns + s]
+                                                         : level_power[level - 1];
                 zone z = {s, (uint8_t)lobe_kind[k], (uint8_t)level,
                           (float)(arriving * o->weight[k] * f3_max(o->color))};
                 if (!(z.power > 0))

@@ -125,7 +125,8 @@ static vec3 reflected(const rscene *rs, vec3 x, vec3 n, int mirror, int light, v
     /* Glass reflects its Fresnel share off its outside (the receiver is
      * outside it, in vacuum; what crosses the glass is gathered). */
     if (m->weight[LOBE_REFRACTIVE] > 0.0f)
-        k += m->weight[LOBE_REFRACTIVE] * bsdf_fresnel_dielectric(cos_i, 1.0f, m->ior);
+        k += m->weight[LOBE_REFRACTIVE] * (m->thin ? bsdf_pane_reflectance(cos_i, m->ior)
+                                                   : bsdf_fresnel_dielectric(cos_i, 1.0f, m->ior));
     rs_part lt;
     vec3f le = light_emitted(rs, rs_prim(rs, light, &lt), v3_to_f3(y),
                              v3_to_f3(v3_normalize(v3_sub(y, s))));

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "geom/accel.h"
+#include "geom/transmittance.h"
 #include "light/env_map.h"
 #include "geom/ray_offset.h"
 #include "render/share.h"
@@ -72,8 +73,9 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
                 continue;
             t->rays++;
             all = f3_madd(all, f->sky_weight[k], c);
-            if (!accel_occluded(rs, o, f->sky_dirs[k], FLT_MAX, 1))
-                seen = f3_madd(seen, f->sky_weight[k], c);
+            vec3f tr = accel_transmittance(rs, o, f->sky_dirs[k], FLT_MAX, 1);
+            if (!f3_is_black(tr))
+                seen = f3_madd(seen, f3_mul(f->sky_weight[k], tr), c);
         }
         vec3 open = sky_open_irradiance(f, nf);
         return v3(all.x > 0.0f ? open.x * seen.x / all.x : open.x,
@@ -83,15 +85,18 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
     vec3 tt, bb;
     v3_frame(n, &tt, &bb);
     vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
-    int open = 0;
+    vec3f open = f3_splat(0.0f);
     for (int k = 0; k < f->q.gather; k++) {
         const vec3 *dk = &f->dirs[k];
         vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
-        hit h = accel_intersect(rs, o, v3_to_f3(d));
+        open = f3_add(open, accel_transmittance(rs, o, v3_to_f3(d), FLT_MAX, 1));
         t->rays++;
-        open += h.part < 0;
     }
-    return v3_scale(v3(rs->sky.x, rs->sky.y, rs->sky.z), 3.14159265358979 * open / f->q.gather);
+    /* Each channel as sky x (pi x count / n): open holds whole counts
+     * unless a pane is in the way. */
+    return v3(rs->sky.x * (3.14159265358979 * open.x / f->q.gather),
+              rs->sky.y * (3.14159265358979 * open.y / f->q.gather),
+              rs->sky.z * (3.14159265358979 * open.z / f->q.gather));
 }
 
 /* Light arriving at level `level` by way of specular surfaces: gathered

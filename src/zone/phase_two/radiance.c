@@ -6,7 +6,9 @@
  *                mesh (camera paths) the level l-1 light gathered there;
  *   specular lobes (mirror, metal, glass) pass the levels below theirs on
  *   along the reflected and refracted rays, deterministically: the glass
- *   lobe follows both the reflected and the transmitted ray. */
+ *   lobe follows both the reflected and the transmitted ray;
+ *   a thin pane passes the light behind it at the same levels (crossing
+ *   it is no scattering), tinted and less what it reflects. */
 #include "zone/zone.h"
 
 #include "geom/accel.h"
@@ -46,10 +48,10 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         return lo <= 0 && !((flags & ZR_NO_EMISSION) && h.part < rs->part_count) && !photons
                    ? f3_to_v3(light_emitted(rs, p, xf, d))
                    : v3(0, 0, 0);
-    if (hi < 1)
+    const rs_object *m = &rs->objects[p->object];
+    if (hi < 1 && !m->thin) /* a pane passes level 0 on */
         return v3(0, 0, 0);
 
-    const rs_object *m = &rs->objects[p->object];
     vec3f ngf = shape_normal(p, xf);
     int back = f3_dot(ngf, d) > 0.0f;
     vec3f nf = back ? f3_neg(ngf) : ngf;
@@ -80,7 +82,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
 
     float wm = m->weight[LOBE_METALLIC], wr = m->weight[LOBE_REFLECTING];
     float wt = m->weight[LOBE_REFRACTIVE];
-    if (hi >= 1 && (wm > 0.0f || wr > 0.0f || wt > 0.0f)) {
+    if ((hi >= 1 || m->thin) && (wm > 0.0f || wr > 0.0f || wt > 0.0f)) {
         vec3f ng_facing = nf;
         nf = sh.ns;
         vec3f wo = f3_neg(d);
@@ -95,7 +97,12 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         float eta_i = media_count ? rs->objects[media[media_count - 1]].ior : 1.0f;
         float eta_t = entering ? m->ior
                                : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
-        if (wt > 0.0f) {
+        vec3 pass = v3(0, 0, 0);
+        if (wt > 0.0f && m->thin) {
+            float fr = bsdf_pane_reflectance(cos_o, m->ior);
+            k_refl += wt * fr;
+            pass = v3_scale(f3_to_v3(m->tint), wt * (1.0 - fr));
+        } else if (wt > 0.0f) {
             float fr = bsdf_fresnel_dielectric(cos_o, eta_i, eta_t);
             k_refl += wt * fr;
             k_tran = wt * (1.0 - fr);
@@ -111,6 +118,11 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                 rflags |= ZR_NO_EMISSION;
             vec3 l = zone_radiance(t, out_o, refl, lo - 1, hi - 1, rflags, media, media_count);
             out = v3_add(out, v3_scale(v3_mul(color, l), k_refl));
+        }
+        if (!v3_is_black(pass)) {
+            vec3 l = zone_radiance(t, ray_offset(xf, f3_neg(ng_facing)), d, lo, hi,
+                                   flags, media, media_count);
+            out = v3_add(out, v3_mul(pass, l));
         }
         if (k_tran > 0) {
             float eta = eta_i / eta_t;

@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "geom/accel.h"
+#include "geom/transmittance.h"
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
 #include "render/prim.h"
@@ -61,7 +62,8 @@ static uint32_t point_light_bits(const rscene *rs, vec3f x, vec3f n, uint64_t *r
         float dist = f3_length(to);
         if (f3_dot(to, n) > 0.0f && dist > 0.0f) {
             (*rays)++;
-            if (!accel_occluded(rs, xo, f3_scale(to, 1.0f / dist), dist, lp->background))
+            if (accel_transmittance_mean(rs, xo, f3_scale(to, 1.0f / dist), dist,
+                                         lp->background) > 0.0f)
                 bits |= 1u << k;
         }
     }
@@ -121,6 +123,12 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
          * glass has its edge where the bent ray leaves it, and the coverage
          * grid must find it there.  Entering or leaving is decided by
          * object identity, as in the tracers, so hollow shells work. */
+        if (m->thin) {
+            /* A pane: the light behind it is seen undeviated, and that is
+             * the branch whose edges matter. */
+            o = ray_offset(x, f3_neg(n));
+            continue;
+        }
         int leaving = p->object == inside;
         float eta = leaving ? m->ior : 1.0f / m->ior;
         float sin2_t = eta * eta * (1.0f - cos_o * cos_o);

@@ -193,6 +193,20 @@ static vec3 specular_value(zone_trace *t, const p2_term *term, const p2_sample *
         k_refl = m->weight[LOBE_METALLIC] * bsdf_schlick(cos_o, m->ior);
         break;
     case ZONE_REFRACT: {
+        if (m->thin) {
+            /* A pane: its reflection of level l-1, and level l behind it
+             * (crossing is no scattering). */
+            float fr = bsdf_pane_reflectance(cos_o, m->ior);
+            vec3 out = v3(0, 0, 0);
+            if (l >= 1) {
+                vec3 li = zone_radiance(t, out_o, refl, l - 1, l - 1, ZR_EXACT_DIRECT, NULL, 0);
+                out = v3_scale(v3_mul(sf.color, li), m->weight[LOBE_REFRACTIVE] * fr);
+            }
+            vec3 lb = zone_radiance(t, ray_offset(sf.xf, f3_neg(sf.nf)), d, l, l,
+                                    ZR_EXACT_DIRECT, NULL, 0);
+            return v3_add(out, v3_scale(v3_mul(f3_to_v3(m->tint), lb),
+                                        m->weight[LOBE_REFRACTIVE] * (1.0 - fr)));
+        }
         float fr = bsdf_fresnel_dielectric(cos_o, eta_i, eta_t);
         k_refl = m->weight[LOBE_REFRACTIVE] * fr;
         k_tran = m->weight[LOBE_REFRACTIVE] * (1.0 - fr);

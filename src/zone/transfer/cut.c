@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "geom/accel.h"
+#include "geom/transmittance.h"
 #include "util/vec3_convert.h"
 
 #define PI 3.14159265358979323846
@@ -65,14 +65,14 @@ typedef struct gather {
     cut_stats *st;
 } gather;
 
-int cut_visible(const rscene *rs, vec3f xo, vec3 to, int background, cut_stats *st)
+double cut_visible(const rscene *rs, vec3f xo, vec3 to, int background, cut_stats *st)
 {
     vec3f d = f3_sub(v3_to_f3(to), xo);
     float dist = f3_length(d);
     if (!(dist > 0.0f))
         return 0;
     st->rays++;
-    return !accel_occluded(rs, xo, f3_scale(d, 1.0f / dist), dist * 0.9999f, background);
+    return accel_transmittance_mean(rs, xo, f3_scale(d, 1.0f / dist), dist * 0.9999f, background);
 }
 
 static double lum(const double v[3])

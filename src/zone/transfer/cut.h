@@ -61,7 +61,8 @@ vec3 cut_gather(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo
 vec3 cut_resume(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo,
                 const cut_record *from, const cut_params *p, cut_stats *st);
 
-/* Whether the straight path from xo to `to` is open (a ray, counted). */
-int cut_visible(const rscene *rs, vec3f xo, vec3 to, int background, cut_stats *st);
+/* How open the straight path from xo to `to` is: 1 or 0, or a pane's
+ * transmittance between (a ray, counted). */
+double cut_visible(const rscene *rs, vec3f xo, vec3 to, int background, cut_stats *st);
 
 #endif

@@ -33,7 +33,7 @@ typedef struct gather {
     double sphere_r;
 } gather;
 
-static int visible(gather *g, vec3 to, int background)
+static double visible(gather *g, vec3 to, int background)
 {
     if (g->sphere_r > 0) {
         vec3 d = v3_sub(to, g->sphere_c);
@@ -75,7 +75,7 @@ static int clip(vec3 *q, int n, vec3 a, double b, double *val, int vals)
  * split while it looks large, else Lambert's formula over it (above the
  * receiver's horizon) times its mean radiance, if a ray reaches it. */
 static void piece(gather *g, const vec3 *q, const double *b, int corners, int background,
-                  int depth, int vis, double acc[3])
+                  int depth, double vis, double acc[3])
 {
     vec3 c = v3(0, 0, 0);
     double size = 0;
@@ -147,13 +147,15 @@ static void piece(gather *g, const vec3 *q, const double *b, int corners, int ba
         double ff = 0.5 * -v3_dot(cr3, w) / dist * cr / (dist * dist);
         if (!(ff > 0))
             return;
-        if (vis < 0 && !visible(g, c, background))
+        if (vis < 0)
+            vis = visible(g, c, background);
+        if (vis == 0)
             return;
         for (int ch = 0; ch < 3; ch++) {
             double mean = 0;
             for (int k = 0; k < corners; k++)
                 mean += b[3 * k + ch];
-            acc[ch] += ff * mean / corners;
+            acc[ch] += ff * mean / corners * vis;
         }
         return;
     }
@@ -183,10 +185,12 @@ static void piece(gather *g, const vec3 *q, const double *b, int corners, int ba
             mean[ch] += v[3 * k + ch] / n;
     }
     pc = v3_scale(pc, 1.0 / n);
-    if (vis < 0 && !visible(g, pc, background))
+    if (vis < 0)
+        vis = visible(g, pc, background);
+    if (vis == 0)
         return;
     for (int ch = 0; ch < 3; ch++)
-        acc[ch] += ff * mean[ch];
+        acc[ch] += ff * mean[ch] * vis;
 }
 
 /* Element i of the tree, exactly. */

@@ -1,0 +1,28 @@
+/* Visibility through thin panes: the one query that lets light cross a
+ * window.  A pane (a material whose refractive lobe is "thin") passes the
+ * light it does not reflect undeviated, so a shadow ray that meets one goes
+ * on, carrying the pane's transmittance; anything else blocks it. */
+#ifndef ZT_GEOM_TRANSMITTANCE_H
+#define ZT_GEOM_TRANSMITTANCE_H
+
+#include "geom/accel.h"
+
+/* What reaches o from the point at distance dist along unit d, as a
+ * colour factor: accel_occluded's rule (the same background rule), with
+ * panes on the way multiplying instead of blocking.  Scenes without panes
+ * pay one accel_occluded call and get 0 or 1. */
+vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
+                          int target_is_background);
+
+/* The same as one number (the channels' mean), for the zone tracer's
+ * scalar visibility. */
+static inline float accel_transmittance_mean(const rscene *rs, vec3f o, vec3f d, float dist,
+                                             int target_is_background)
+{
+    if (!rs->pane_count)
+        return accel_occluded(rs, o, d, dist, target_is_background) ? 0.0f : 1.0f;
+    vec3f t = accel_transmittance(rs, o, d, dist, target_is_background);
+    return (t.x + t.y + t.z) * (1.0f / 3.0f);
+}
+
+#endif
