@@ -265,6 +265,81 @@ static void test_short_block_zone(void **state)
     zt_scene_release(msh);
 }
 
+/* A room 4 x 3 x 4 of thin walls, two triangles each, with an opening in
+ * the wall x = 4, lit through it by the sun and the sky: as scene
+ * triangles (mesh 0) or as one smooth mesh (1). */
+static zt_scene *window_room(int as_mesh)
+{
+    static const double quad[][4][3] = {
+        {{0, 0, 0}, {4, 0, 0}, {4, 0, 4}, {0, 0, 4}}, {{0, 3, 0}, {0, 3, 4}, {4, 3, 4}, {4, 3, 0}},
+        {{0, 0, 0}, {0, 0, 4}, {0, 3, 4}, {0, 3, 0}}, {{0, 0, 0}, {0, 3, 0}, {4, 3, 0}, {4, 0, 0}},
+        {{0, 0, 4}, {4, 0, 4}, {4, 3, 4}, {0, 3, 4}}, {{4, 0, 0}, {4, 0, 4}, {4, 1, 4}, {4, 1, 0}},
+        {{4, 2, 0}, {4, 2, 4}, {4, 3, 4}, {4, 3, 0}}, {{4, 1, 0}, {4, 1, 1.5}, {4, 2, 1.5}, {4, 2, 0}},
+        {{4, 1, 2.5}, {4, 1, 4}, {4, 2, 4}, {4, 2, 2.5}}};
+    enum { QUADS = sizeof quad / sizeof quad[0] };
+    char text[8192], obj[4096];
+    size_t len = (size_t)snprintf(
+        text, sizeof text,
+        "{\"camera\": {\"position\": [0.3, 1.5, 0.3], \"lookat\": [4, 1, 3], \"fov\": 75, "
+        "\"gridresolution\": [48, 36]}, \"scene\": [{\"sun\": {\"direction\": [1, 0.8, 0.3], "
+        "\"irradiance\": [800, 800, 800]}}, {\"sky\": {\"color\": [0.6, 0.7, 0.9]}},");
+    size_t ol = 0;
+    for (int q = 0; q < QUADS; q++) {
+        for (int k = 0; k < 4; k++)
+            ol += (size_t)snprintf(obj + ol, sizeof obj - ol, "v %g %g %g\n", quad[q][k][0],
+                                   quad[q][k][1], quad[q][k][2]);
+        ol += (size_t)snprintf(obj + ol, sizeof obj - ol, "f %d %d %d\nf %d %d %d\n", 4 * q + 1,
+                               4 * q + 2, 4 * q + 3, 4 * q + 1, 4 * q + 3, 4 * q + 4);
+        if (!as_mesh)
+            for (int t = 0; t < 2; t++) {
+                const double *a = quad[q][0], *b = quad[q][t + 1], *c = quad[q][t + 2];
+                len += (size_t)snprintf(text + len, sizeof text - len,
+                                        "{\"triangle\": {\"points\": [[%g, %g, %g], [%g, %g, %g], "
+                                        "[%g, %g, %g]], " TEST_DIFFUSE(0.7) "}},",
+                                        a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]);
+            }
+    }
+    if (as_mesh)
+        len += (size_t)snprintf(text + len, sizeof text - len,
+                                "{\"mesh\": {\"file\": \"%s\", " TEST_DIFFUSE(0.7) "}},",
+                                test_write_file("window_room.obj", obj));
+    snprintf(text + len, sizeof text - len,
+             "{\"plane\": {\"normal\": [0, 1, 0], \"offset\": -0.05, " TEST_DIFFUSE(0.3) "}}]}");
+    return test_scene_text(text, as_mesh ? "window_room_mesh.json" : "window_room.json");
+}
+
+static double image_mean(const zt_image *im)
+{
+    double s = 0;
+    for (int i = 0; i < 3 * im->width * im->height; i++)
+        s += im->pixels[i];
+    return s / (3.0 * im->width * im->height);
+}
+
+/* Where the floor meets a wall, a smooth mesh's corner node stood on the
+ * wall's plane, and its rays through the wall's far side passed: the room
+ * as a mesh was 44% brighter at level 2 than as triangles, with bright
+ * lines along every corner.  Its level 2 is now the triangles' within 5%
+ * (measured 2.3%; the mesh's nodes are coarser). */
+static void test_window_room_zone(void **state)
+{
+    (void)state;
+    zt_scene *tri = window_room(0), *msh = window_room(1);
+    zt_render_options o = zt_render_options_default();
+    o.method = ZT_METHOD_ZONE;
+    o.level = 2;
+    o.threads = 2;
+    zt_image *a = render(tri, &o), *m = render(msh, &o);
+    double ma = image_mean(a), mm = image_mean(m);
+    printf("window room, zone level 2: mesh %.4f, triangles %.4f (%+.2f%%)\n", mm, ma,
+           100 * (mm / ma - 1));
+    assert_true(fabs(mm / ma - 1) < 0.05);
+    zt_image_release(a);
+    zt_image_release(m);
+    zt_scene_release(tri);
+    zt_scene_release(msh);
+}
+
 /* ---------------------------------------------------------------------- */
 /* Furnaces */
 
@@ -438,6 +513,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_short_block_path),
         cmocka_unit_test(test_short_block_zone),
+        cmocka_unit_test(test_window_room_zone),
         cmocka_unit_test(test_sphere_in_white_sky),
         cmocka_unit_test(test_closed_sphere_furnace),
         cmocka_unit_test(test_closed_sphere_first_bounce_zone),
