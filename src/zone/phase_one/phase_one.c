@@ -173,7 +173,7 @@ static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
  * too bright at level 2, bright lines along every corner), the inside of
  * a thick wall (a house's rooms too dark).  Moved inside its triangle, the
  * node is off the other planes; the move is far below the node spacing. */
-#define NODE_INSET 1e-3
+#define NODE_INSET 1e-4
 
 static vec3 node_point(const surface_nodes *sn, const rscene *rs, int32_t k, vec3 *n)
 {
