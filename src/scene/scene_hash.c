@@ -21,8 +21,10 @@ uint64_t scene_hash(const zt_scene *sc)
             fnv_f64(&h, o->mat.weight[k]);
         fnv_v3(&h, o->mat.color);
         fnv_f64(&h, o->mat.ior);
-        fnv_i32(&h, o->mat.thin);
-        fnv_v3(&h, o->mat.tint);
+        if (o->mat.thin) { /* (only then: earlier forests stay valid) */
+            fnv_i32(&h, o->mat.thin);
+            fnv_v3(&h, o->mat.tint);
+        }
         fnv_v3(&h, o->emission);
         fnv_i32(&h, o->first_part);
         fnv_i32(&h, o->part_count);
@@ -65,8 +67,10 @@ uint64_t scene_hash(const zt_scene *sc)
                 fnv_f64(&h, sl->mat.weight[l]);
             fnv_v3(&h, sl->mat.color);
             fnv_f64(&h, sl->mat.ior);
-            fnv_i32(&h, sl->mat.thin);
-            fnv_v3(&h, sl->mat.tint);
+            if (sl->mat.thin) {
+                fnv_i32(&h, sl->mat.thin);
+                fnv_v3(&h, sl->mat.tint);
+            }
             fnv_v3(&h, sl->emission);
             fnv_i32(&h, sl->texture);
         }
