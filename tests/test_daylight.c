@@ -23,19 +23,6 @@
 #define PI 3.14159265358979323846
 #define DIFFUSE_HALF TEST_DIFFUSE(0.5)
 
-static zt_image *render(const zt_scene *s, zt_method method, int level, int depth, int spp)
-{
-    zt_render_options o = zt_render_options_default();
-    o.method = method;
-    o.level = level;
-    o.depth = depth;
-    o.spp = spp;
-    zt_image *im = NULL;
-    zt_error err = {0};
-    if (zt_render(s, &o, &im, NULL, &err) != ZT_OK)
-        fail_msg("render: %s", err.message);
-    return im;
-}
 
 static double image_mean(const zt_image *im, int channel)
 {
@@ -76,7 +63,7 @@ static void test_sun_floor(void **state)
     zt_scene *s = test_scene_text(text, "sun_floor");
     const double irr[3] = {1000, 800, 600};
     for (int m = 0; m < 2; m++) {
-        zt_image *im = render(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, -1, 3, 16);
+        zt_image *im = test_render_level(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, -1, 3, 16);
         double worst = 0;
         for (int c = 0; c < 3; c++) {
             double want = 0.5 * irr[c] * sin(e) / PI;
@@ -139,7 +126,7 @@ static void test_sun_penumbra(void **state)
     }
     double want = (t90 - t10) * r;
     for (int m = 0; m < 2; m++) {
-        zt_image *im = render(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, 1, 1, 256);
+        zt_image *im = test_render_level(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, 1, 1, 256);
         double row[240], x[240], full = 0;
         for (int i = 0; i < 240; i++) {
             double v = 0;
@@ -184,7 +171,7 @@ static void test_env_furnace(void **state)
     zt_scene *s = test_scene_text(text, "env_furnace");
     const double want[3] = {1.2, 0.9, 0.6};
     for (int m = 0; m < 2; m++) {
-        zt_image *im = render(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, -1, 8, 64);
+        zt_image *im = test_render_level(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, -1, 8, 64);
         for (int c = 0; c < 3; c++) {
             double mean = image_mean(im, c);
             print_message("%s: furnace channel %d: %.5f (want %.5f)\n", m ? "zone" : "path", c,
@@ -213,7 +200,7 @@ static void centre_colour(const char *map, double rotate, const double look[3], 
              "\"camera\": {\"position\": [0, 0, 0], \"lookat\": [%g, %g, %g], \"fov\": 2, "
              "\"gridresolution\": [2, 2]}}", map, rotate, look[0], look[1], look[2]);
     zt_scene *s = test_scene_text(text, "env_orientation");
-    zt_image *im = render(s, ZT_METHOD_PATH, -1, 1, 4);
+    zt_image *im = test_render_level(s, ZT_METHOD_PATH, -1, 1, 4);
     for (int c = 0; c < 3; c++)
         out[c] = (float)image_mean(im, c);
     zt_image_release(im);

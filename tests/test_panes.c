@@ -12,19 +12,6 @@
 #define PI 3.14159265358979323846
 #define DIFFUSE_HALF TEST_DIFFUSE(0.5)
 
-static zt_image *render(const zt_scene *s, zt_method method, int level, int depth, int spp)
-{
-    zt_render_options o = zt_render_options_default();
-    o.method = method;
-    o.level = level;
-    o.depth = depth;
-    o.spp = spp;
-    zt_image *im = NULL;
-    zt_error err = {0};
-    if (zt_render(s, &o, &im, NULL, &err) != ZT_OK)
-        fail_msg("render: %s", err.message);
-    return im;
-}
 
 /* Unpolarised Fresnel reflectance from vacuum into index n (written out
  * here, not taken from the renderer). */
@@ -72,7 +59,7 @@ static void test_sun_through_pane(void **state)
     const double open = 0.5 * 1000 * sin(e) / PI, tint[3] = {0.9, 0.7, 0.5};
     const double pass = 0.8 * (1 - slab_reflectance(sin(e), 1.5));
     for (int m = 0; m < 2; m++) {
-        zt_image *im = render(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, 1, 1, 16);
+        zt_image *im = test_render_level(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, 1, 1, 16);
         /* Light through the pane reaches the floor's x < 0 (the left
          * columns), the sun in the open its x > 0. */
         double worst = 0;
@@ -108,7 +95,7 @@ static void test_pane_furnace(void **state)
         "\"gridresolution\": [8, 8]}}";
     zt_scene *s = test_scene_text(text, "pane_furnace");
     for (int m = 0; m < 2; m++) {
-        zt_image *im = render(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, -1, 4, 64);
+        zt_image *im = test_render_level(s, m ? ZT_METHOD_ZONE : ZT_METHOD_PATH, -1, 4, 64);
         double worst = 0;
         for (int i = 0; i < 3 * im->width * im->height; i++)
             worst = fmax(worst, fabs(im->pixels[i] - 1));

@@ -120,8 +120,6 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             break; /* lights absorb what reaches them */
         }
         const rs_object *m = &rs->objects[p->object];
-        vec3f ng = shape_normal(p, x);
-        vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
         /* A pane passes the light it does not reflect undeviated: not a
          * scattering event (the level, the MIS state and the segment's
          * start stay), chosen with its probability so the weight is the
@@ -129,14 +127,15 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
          * weights renormalised, the pane's lobe reflecting only. */
         float pane_keep = 1.0f, pane_r = 0.0f;
         if (__builtin_expect(m->thin, 0)) {
-            float c = -f3_dot(n, d);
-            pane_r = bsdf_pane_reflectance(c, m->ior);
+            vec3f ng = shape_normal(p, x);
+            float c = f3_dot(ng, d);
+            pane_r = bsdf_pane_reflectance(fabsf(c), m->ior);
             float p_pass = m->weight[LOBE_REFRACTIVE] * (1.0f - pane_r);
             if (sampler_next(&rng) < p_pass) {
                 beta = f3_mul(beta, m->tint);
                 if (f3_is_black(beta) || ++panes > PANES_MAX)
                     break;
-                o = ray_offset(x, f3_neg(n));
+                o = ray_offset(x, c > 0.0f ? ng : f3_neg(ng));
                 seg_t += h.t;
                 continue;
             }
@@ -146,6 +145,8 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             break;
         k++;
 
+        vec3f ng = shape_normal(p, x);
+        vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
         vec3f wo = f3_neg(d);
         /* Meshes: the shading normal ns (the geometric n still decides
          * sides) and a textured albedo, in a copy of the material. */

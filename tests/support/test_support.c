@@ -125,6 +125,20 @@ zt_scene *test_scene_text(const char *text, const char *name)
     return s;
 }
 
+zt_image *test_render_level(const zt_scene *s, zt_method method, int level, int depth, int spp)
+{
+    zt_render_options o = zt_render_options_default();
+    o.method = method;
+    o.level = level;
+    o.depth = depth;
+    o.spp = spp;
+    zt_image *im = NULL;
+    zt_error err = {0};
+    if (zt_render(s, &o, &im, NULL, &err) != ZT_OK)
+        fail_msg("render: %s", err.message);
+    return im;
+}
+
 zt_renderer *test_zone_renderer(const zt_scene *s, int depth, int threads, int quality)
 {
     zt_render_options o = zt_render_options_default();

@@ -30,6 +30,11 @@ const char *test_tmp_dir(void);
 /* tmp_dir/name in a static rotating buffer. */
 const char *test_tmp_path(const char *name);
 
+/* Renders s with one method at level (-1: all up to depth) and spp samples
+ * per pixel (path), the other options at their defaults; fails the test
+ * with the renderer's message on error. */
+zt_image *test_render_level(const zt_scene *s, zt_method method, int level, int depth, int spp);
+
 /* Writes text to tmp_dir/name and returns that path. */
 const char *test_write_file(const char *name, const char *text);
 

@@ -410,17 +410,18 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
     int found = occluders_query(c->occ, &region, cand, DIRECT_MAX_OCCLUDERS);
     if (found > DIRECT_MAX_OCCLUDERS)
         return -1;
-    /* A pane lets part of the light through: not a shadow that clipping
-     * can draw, so its points take rays (which see through it). */
-    for (int k = 0; k < found && c->rs->pane_count; k++) {
+    for (int k = 0; k < found; k++) {
+        if (cand[k] == receiver || cand[k] == light)
+            continue;
+        /* A pane lets part of the light through: not a shadow that
+         * clipping can draw, so its points take rays (which see through
+         * it). */
         rs_part tmp;
-        if (c->rs->objects[rs_prim(c->rs, cand[k], &tmp)->object].thin)
+        if (c->rs->pane_count && c->rs->objects[rs_prim(c->rs, cand[k], &tmp)->object].thin)
             return -1;
-    }
-    for (int k = 0; k < found; k++)
-        if (cand[k] != receiver && cand[k] != light &&
-            occlude_by(c, cand[k], &lpp, f, x, n, &fr, set, scratch))
+        if (occlude_by(c, cand[k], &lpp, f, x, n, &fr, set, scratch))
             return 0;
+    }
     return set->overflow ? -1 : 1;
 }
 
@@ -546,7 +547,7 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
         if (keep)
             seen[at++] = s;
         else if (!f3_is_black(s))
-            e = v3_add(e, v3_mul(f3_to_v3(s), v3_splat(lambert_polygon(x, n, q, 3))));
+            e = v3_add(e, v3_scale(f3_to_v3(s), lambert_polygon(x, n, q, 3)));
         seen_count += f3_max(s);
     }
     if (!keep)
@@ -568,8 +569,7 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
         vec3 part = by_hidden ? v3_sub(v3_splat(1.0), s) : s;
         if (part.x > 0 || part.y > 0 || part.z > 0) {
             double g = lambert_polygon(x, n, q, 3);
-            vec3 pg = v3(part.x * g, part.y * g, part.z * g);
-            e = by_hidden ? v3_sub(e, pg) : v3_add(e, pg);
+            e = by_hidden ? v3_sub(e, v3_scale(part, g)) : v3_add(e, v3_scale(part, g));
         }
     }
     return v3(e.x > 0 ? e.x : 0, e.y > 0 ? e.y : 0, e.z > 0 ? e.z : 0);
