@@ -374,8 +374,12 @@ static void print_scene(const render_job *job)
         fprintf(stderr, "note: %lld vertex normals of the models were not finite or "
                 "zero and were replaced by the faces' normals\n", info.replaced_normals);
     if (info.rough_materials)
-        fprintf(stderr, "note: %d model materials have a roughness, which is ignored: "
-                "metal, mirror and glass lobes are smooth\n", info.rough_materials);
+        fprintf(stderr, "note: %d model materials have a roughness, which is not read from "
+                "model files yet: their metal, mirror and glass lobes are smooth\n",
+                info.rough_materials);
+    if (info.rough_lobes && o->method == ZT_METHOD_ZONE)
+        fprintf(stderr, "note: %d materials are rough; the zone tracer renders their lobes "
+                "smooth (docs/zone-tracer.md, \"Rough lobes\")\n", info.rough_lobes);
     if (info.panes)
         fprintf(stderr, "note: %d materials are thin panes: light crosses them undeviated "
                 "(docs/scene-format.md, \"thin\")\n", info.panes);

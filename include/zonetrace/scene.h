@@ -56,8 +56,11 @@ typedef struct zt_scene_info {
     long long skipped_triangles; /* degenerate ones the import left out */
     long long replaced_normals; /* vertex normals of a model that were not
                                    finite or zero, replaced from the faces */
-    int rough_materials; /* materials whose roughness the smooth lobes
-                            cannot represent (it is ignored) */
+    int rough_materials; /* model files' materials whose roughness is not
+                            read yet (their lobes are smooth) */
+    int rough_lobes;  /* scene materials with a roughness above 0 and a
+                         metallic, reflecting or refractive lobe: GGX in
+                         the path tracer, smooth in the zone tracer */
     int missing_textures; /* textures a model names but that are missing or
                              cannot be decoded (left out: base colour only) */
     char texture_problem[160]; /* the first of them and why */

@@ -1,10 +1,12 @@
 /* The four-part material: a weighted sum of a Lambertian diffuse lobe, a
- * Schlick-Fresnel metal reflector, an ideal mirror and a smooth dielectric,
- * all tinted by the material colour (docs/light-transport.md).  Only the
- * diffuse lobe has a density; the others are Dirac deltas. */
+ * Schlick-Fresnel metal reflector, a mirror and a dielectric, all tinted by
+ * the material colour (docs/light-transport.md).  With roughness 0 the
+ * last three are smooth (Dirac deltas); above it they are GGX lobes
+ * (material/microfacet.h), which have densities like the diffuse one. */
 #ifndef ZT_MATERIAL_BSDF_H
 #define ZT_MATERIAL_BSDF_H
 
+#include "material/fresnel.h"
 #include "render/render_scene.h"
 #include "util/sincos_turn.h"
 
@@ -22,7 +24,8 @@ typedef struct shading_frame {
 typedef struct bsdf_sample {
     vec3f wi;       /* new direction, unit */
     vec3f weight;   /* f * |cos| / pdf: the throughput factor */
-    float pdf;      /* density of the diffuse choice (0 for deltas) */
+    float pdf;      /* density of the choice, lobe weight included (0 for
+                       deltas) */
     int delta;      /* chosen lobe is a delta (no MIS) */
     int transmit;   /* crossed the surface (refraction) */
 } bsdf_sample;
@@ -64,14 +67,6 @@ static inline int bsdf_sample_diffuse(const rs_object *m, const shading_frame *f
     return out->pdf > 0.0f;
 }
 
-/* Schlick's Fresnel with R0 from the index, as the original programs
- * meant "metallic" (indices below 1 give metal-like R0). */
-float bsdf_schlick(float cos_i, float ior);
-
-/* Unpolarised Fresnel reflectance of a smooth dielectric, going from index
- * eta_i into eta_t; 1 under total internal reflection. */
-float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t);
-
 /* A thin pane (a material with "thin": its refractive lobe is a sheet of
  * glass): the light it reflects at cosine cos_i, both faces and their
  * inter-reflections counted, R = 2 r / (1 + r) for one face's r.  What it
@@ -85,6 +80,21 @@ static inline vec3f bsdf_pane_transmittance(const rs_object *m, float cos_i)
     return f3_scale(m->tint, m->weight[LOBE_REFRACTIVE] *
                                  (1.0f - bsdf_pane_reflectance(cos_i, m->ior)));
 }
+
+/* Whether lobe k of m is a GGX lobe. */
+static inline int bsdf_lobe_rough(const rs_object *m, int k)
+{
+    return m->alpha > 0.0f && k != LOBE_DIFFUSE && m->weight[k] > 0.0f &&
+           !(k == LOBE_REFRACTIVE && m->thin);
+}
+
+/* m's rough lobes for light arriving from wi and leaving toward wo (next-
+ * event estimation): for each such lobe k, fcos[k] = weight x f x |cos_i|
+ * (the colour apart) and pdf[k] = weight x the density of the lobe choosing
+ * wi; other entries 0.  wi may be on either side of f->n (rough
+ * transmission); eta_i, eta_t as for bsdf_sample_material. */
+void bsdf_eval_rough(const rs_object *m, const shading_frame *f, vec3f wo, vec3f wi,
+                     float eta_i, float eta_t, float fcos[LOBE_COUNT], float pdf[LOBE_COUNT]);
 
 /* Samples the material at a point with frame f (f->n facing the side of
  * wo, the direction towards the previous vertex).  u_lobe picks the lobe,

@@ -62,6 +62,23 @@ static float medium_ior(const rscene *rs, const media *m, int depth_from_top)
     return i >= 0 ? rs->objects[m->obj[i]].ior : 1.0f;
 }
 
+/* A rough lobe's share of next-event estimation toward wi: the sum over
+ * the lobes of colour x weight x f x |cos| x MIS weight / p_light.  n is the
+ * geometric normal on wo's side; a shading normal that puts wi on the
+ * other side of it than the surface does gives nothing (light would leak). */
+static vec3f nee_rough(const rs_object *m, const shading_frame *frame, vec3f n, vec3f wo,
+                       vec3f wi, float eta_i, float eta_t, float p_light, int light_delta)
+{
+    if ((f3_dot(n, wi) > 0.0f) != (f3_dot(frame->n, wi) > 0.0f))
+        return f3_splat(0.0f);
+    float fcos[LOBE_COUNT], pdf[LOBE_COUNT], sum = 0.0f;
+    bsdf_eval_rough(m, frame, wo, wi, eta_i, eta_t, fcos, pdf);
+    for (int k = 0; k < LOBE_COUNT; k++)
+        if (fcos[k] > 0.0f)
+            sum += fcos[k] * (light_delta ? 1.0f / p_light : power_heuristic_over(p_light, pdf[k]));
+    return f3_scale(m->color, sum);
+}
+
 path_pixel path_pixel_make(uint32_t key)
 {
     path_pixel px = {key, {0}};
@@ -178,7 +195,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             m = &pane_vertex;
         }
         uint32_t pair = 1 + (uint32_t)(k - 1) * PAIRS_PER_VERTEX;
-        int nee = k >= pp->min_level && m->weight[LOBE_DIFFUSE] > 0.0f;
+        int nee = k >= pp->min_level && (m->weight[LOBE_DIFFUSE] > 0.0f || m->rough);
         /* Numbers from the stream are drawn only where a choice needs
          * them: most materials have one lobe, most scenes few lights. */
         float u_light[2] = {0.0f, 0.0f}, u_dir[2];
@@ -196,13 +213,31 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         float u_select = nee && rs->light_count > 1 ? sampler_next(&rng) : 0.0f;
         vec3f x_out = ray_offset(x, n);
 
-        /* Next-event estimation through the diffuse lobe. */
+        /* Flat parts carry their frame; with n flipped, (t, b, n) is still
+         * orthonormal (left-handed), which isotropic lobes do not mind. */
+        shading_frame frame = {p->tangent, p->bitangent, ns};
+        if (p->shape == SHAPE_SPHERE || bent)
+            f3_basis(ns, &frame.t, &frame.b);
+        int entering = med.n == 0 || med.obj[med.n - 1] != p->object;
+        float eta_i = 1.0f, eta_t = 1.0f;
+        if (m->weight[LOBE_REFRACTIVE] > 0.0f) {
+            eta_i = medium_ior(rs, &med, 0);
+            eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
+        }
+
+        /* Next-event estimation through the diffuse lobe, and the rough
+         * lobes (each with its own MIS weight: its density is its own
+         * strategy's). */
         light_sample ls;
-        if (nee && light_sample_point(rs, x, u_select, u_light, &ls) &&
-            (!bent || f3_dot(n, ls.wi) > 0.0f)) {
-            float bsdf_pdf;
-            vec3f fcos = bsdf_eval_diffuse(m, ns, ls.wi, &bsdf_pdf);
-            if (bsdf_pdf > 0.0f && !f3_is_black(ls.li)) {
+        if (nee && light_sample_point(rs, x, u_select, u_light, &ls) && !f3_is_black(ls.li)) {
+            float bsdf_pdf = 0.0f;
+            vec3f fcos = f3_splat(0.0f), rough = f3_splat(0.0f);
+            int below = f3_dot(n, ls.wi) <= 0.0f;
+            if (!bent || !below)
+                fcos = bsdf_eval_diffuse(m, ns, ls.wi, &bsdf_pdf);
+            if (m->rough)
+                rough = nee_rough(m, &frame, n, wo, ls.wi, eta_i, eta_t, ls.pdf, ls.delta);
+            if (bsdf_pdf > 0.0f || !f3_is_black(rough)) {
                 n_rays++;
                 rs_part ltri;
                 const rs_part *lp = rs_prim(rs, ls.part, &ltri);
@@ -210,17 +245,21 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                  * point itself: near a sphere's rim, keeping the direction
                  * and distance measured from x would graze the light and
                  * find it blocking itself. */
-                vec3f to_y = f3_sub(f3_madd(x, ls.wi, ls.dist), x_out);
+                vec3f from = below ? ray_offset(x, f3_neg(n)) : x_out;
+                vec3f to_y = f3_sub(f3_madd(x, ls.wi, ls.dist), from);
                 float dist_y = f3_length(to_y);
                 vec3f dir_y = f3_scale(to_y, 1.0f / dist_y);
-                vec3f tr = accel_transmittance(rs, x_out, dir_y, dist_y * 0.9999f,
+                vec3f tr = accel_transmittance(rs, from, dir_y, dist_y * 0.9999f,
                                                lp->background);
                 if (!f3_is_black(tr)) {
-                    float w_over_pdf = ls.delta ? 1.0f / ls.pdf
-                                                : power_heuristic_over(ls.pdf, bsdf_pdf);
-                    radiance = f3_add(radiance,
-                                      f3_scale(f3_mul(f3_mul(f3_mul(beta, fcos), ls.li), tr),
-                                               w_over_pdf));
+                    if (bsdf_pdf > 0.0f) {
+                        float w_over_pdf = ls.delta ? 1.0f / ls.pdf
+                                                    : power_heuristic_over(ls.pdf, bsdf_pdf);
+                        radiance = f3_add(radiance,
+                                          f3_scale(f3_mul(f3_mul(f3_mul(beta, fcos), ls.li), tr),
+                                                   w_over_pdf));
+                    }
+                    radiance = f3_add(radiance, f3_mul(f3_mul(f3_mul(beta, rough), ls.li), tr));
                 }
             }
         }
@@ -235,28 +274,33 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 u_far[1] = sampler_next(&rng);
             }
             vec3f wi, li;
-            float far_pdf, bsdf_pdf;
+            float far_pdf, bsdf_pdf = 0.0f;
             if (distant_sample(&rs->distant, u_pick, u_far, &wi, &far_pdf, &li) &&
-                (!bent || f3_dot(n, wi) > 0.0f)) {
-                vec3f fcos = bsdf_eval_diffuse(m, ns, wi, &bsdf_pdf);
-                if (bsdf_pdf > 0.0f && !f3_is_black(li)) {
+                !f3_is_black(li)) {
+                vec3f fcos = f3_splat(0.0f), rough = f3_splat(0.0f);
+                int below = f3_dot(n, wi) <= 0.0f;
+                if (!bent || !below)
+                    fcos = bsdf_eval_diffuse(m, ns, wi, &bsdf_pdf);
+                if (m->rough)
+                    rough = nee_rough(m, &frame, n, wo, wi, eta_i, eta_t, far_pdf, 0);
+                if (bsdf_pdf > 0.0f || !f3_is_black(rough)) {
                     n_rays++;
                     /* Escaping means meeting nothing, background included. */
-                    vec3f tr = accel_transmittance(rs, x_out, wi, FLT_MAX, 1);
-                    if (!f3_is_black(tr))
-                        radiance = f3_add(radiance,
-                                          f3_scale(f3_mul(f3_mul(f3_mul(beta, fcos), li), tr),
-                                                   power_heuristic_over(far_pdf, bsdf_pdf)));
+                    vec3f tr = accel_transmittance(rs, below ? ray_offset(x, f3_neg(n)) : x_out,
+                                                   wi, FLT_MAX, 1);
+                    if (!f3_is_black(tr)) {
+                        if (bsdf_pdf > 0.0f)
+                            radiance = f3_add(
+                                radiance,
+                                f3_scale(f3_mul(f3_mul(f3_mul(beta, fcos), li), tr),
+                                         power_heuristic_over(far_pdf, bsdf_pdf)));
+                        radiance = f3_add(radiance, f3_mul(f3_mul(f3_mul(beta, rough), li), tr));
+                    }
                 }
             }
         }
 
-        /* Continue along a sampled direction.  Flat parts carry their
-         * frame; with n flipped, (t, b, n) is still orthonormal
-         * (left-handed), which the cosine lobe does not mind. */
-        shading_frame frame = {p->tangent, p->bitangent, ns};
-        if (p->shape == SHAPE_SPHERE || bent)
-            f3_basis(ns, &frame.t, &frame.b);
+        /* Continue along a sampled direction. */
         bsdf_sample bs;
         if (!m->lobe_choice && m->weight[LOBE_DIFFUSE] > 0.0f) {
             /* Diffuse only, the common case: no lobe or split to draw, no
@@ -271,9 +315,6 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 break;
             o = x_out;
         } else {
-            int entering = med.n == 0 || med.obj[med.n - 1] != p->object;
-            float eta_i = medium_ior(rs, &med, 0);
-            float eta_t = entering ? m->ior : medium_ior(rs, &med, 1);
             float u_lobe = m->lobe_choice ? sampler_next(&rng) : 0.0f;
             float u_split = m->weight[LOBE_REFRACTIVE] > 0.0f ? sampler_next(&rng) : 0.0f;
             if (!bsdf_sample_material(m, &frame, wo, u_lobe, u_split, u_dir,

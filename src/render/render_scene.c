@@ -6,6 +6,7 @@
 
 #include "geom/accel.h"
 #include "light/distant.h"
+#include "material/microfacet.h"
 #include "render/prim.h"
 #include "scene/mesh.h"
 #include "util/error.h"
@@ -46,6 +47,12 @@ static void fill_object(rs_object *ro, const material *mat, vec3 emission, int i
     ro->ior = (float)mat->ior;
     ro->thin = (uint8_t)(mat->thin && mat->weight[LOBE_REFRACTIVE] > 0);
     ro->tint = v3_to_f3(mat->tint);
+    ro->alpha = mat->roughness > 0 ? (float)(mat->roughness * mat->roughness) : 0.0f;
+    if (ro->alpha > 0.0f && ro->alpha < GGX_ALPHA_MIN)
+        ro->alpha = GGX_ALPHA_MIN;
+    ro->rough = (uint8_t)(ro->alpha > 0.0f &&
+                          (ro->weight[LOBE_METALLIC] > 0.0f || ro->weight[LOBE_REFLECTING] > 0.0f ||
+                           (ro->weight[LOBE_REFRACTIVE] > 0.0f && !ro->thin)));
     ro->is_light = (uint8_t)is_light;
     ro->culled = (uint8_t)o->backculled;
     ro->background = (uint8_t)o->background;

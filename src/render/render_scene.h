@@ -44,6 +44,10 @@ typedef struct rs_object {
     uint8_t lobe_choice; /* more than one lobe has weight: choosing takes a
                             random number */
     uint8_t thin;       /* the refractive lobe is a pane (bsdf_pane) */
+    uint8_t rough;      /* a lobe is GGX (material/microfacet.h): alpha > 0
+                           and a metallic, reflecting or non-pane
+                           refractive weight */
+    float alpha;        /* GGX alpha = roughness^2 (0: smooth lobes) */
     vec3f tint;         /* a pane's transmission colour */
     const struct mesh_texture *texture; /* base colour, times color; NULL */
 } rs_object;

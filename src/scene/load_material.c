@@ -1,5 +1,6 @@
-/* Materials: the four lobe weights, the albedo, the refractive index and
- * whether the refractive lobe is a thin pane. */
+/* Materials: the four lobe weights, the albedo, the refractive index,
+ * the roughness of the non-diffuse lobes and whether the refractive lobe is
+ * a thin pane. */
 #include "scene/scene_reader.h"
 
 #include <math.h>
@@ -40,7 +41,7 @@ static zt_status load_character(load_ctx *ctx, jref ref, double *weight)
 zt_status load_material(load_ctx *ctx, jref ref, material *out)
 {
     static const char *const keys[] = {
-        "character", "color", "refractiveindex", "thin", NULL
+        "character", "color", "refractiveindex", "roughness", "thin", NULL
     };
     material m = material_default();
     if (load_object(ctx, ref, "material") ||
@@ -57,6 +58,13 @@ zt_status load_material(load_ctx *ctx, jref ref, material *out)
         if (m.ior <= 0)
             return load_fail(ctx, ior, "refractiveindex must be positive, not %g",
                              m.ior);
+    }
+    jref rough = jref_member(ref.value, "roughness");
+    if (rough.value) {
+        if (load_number(ctx, rough, &m.roughness))
+            return ZT_ERR_PARSE;
+        if (!(m.roughness >= 0 && m.roughness <= 1))
+            return load_fail(ctx, rough, "roughness must be in [0, 1], not %g", m.roughness);
     }
     jref thin = jref_member(ref.value, "thin");
     if (thin.value) {

@@ -162,6 +162,8 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
     for (int i = 0; i < scene->object_count; i++) {
         const object *o = &scene->objects[i];
         out->panes += o->mesh < 0 && o->mat.thin;
+        out->rough_lobes += o->mesh < 0 && !o->is_light && o->mat.roughness > 0 &&
+                            o->mat.weight[LOBE_DIFFUSE] < 1;
         if (o->mesh < 0)
             continue;
         const struct mesh *m = scene->meshes[o->mesh];

@@ -22,6 +22,8 @@ typedef struct material {
     int thin;                  /* the refractive lobe is a thin pane: light
                                   crosses it undeviated (docs/light-transport.md) */
     vec3 tint;                 /* a pane's transmission colour */
+    double roughness;          /* of the metallic, reflecting and refractive
+                                  lobes, in [0,1]; 0 smooth (GGX above) */
 } material;
 
 typedef enum part_shape {

@@ -25,6 +25,8 @@ uint64_t scene_hash(const zt_scene *sc)
             fnv_i32(&h, o->mat.thin);
             fnv_v3(&h, o->mat.tint);
         }
+        if (o->mat.roughness > 0)
+            fnv_f64(&h, o->mat.roughness);
         fnv_v3(&h, o->emission);
         fnv_i32(&h, o->first_part);
         fnv_i32(&h, o->part_count);
@@ -71,6 +73,8 @@ uint64_t scene_hash(const zt_scene *sc)
                 fnv_i32(&h, sl->mat.thin);
                 fnv_v3(&h, sl->mat.tint);
             }
+            if (sl->mat.roughness > 0)
+                fnv_f64(&h, sl->mat.roughness);
             fnv_v3(&h, sl->emission);
             fnv_i32(&h, sl->texture);
         }
