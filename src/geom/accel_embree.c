@@ -2,15 +2,19 @@
  * scene with up to two geometries for the parts, the triangles and the
  * spheres, and one per mesh, which reads the mesh's own arrays (shared
  * buffers: nothing is copied).  Embree has no per-primitive back-face
- * culling, so culled primitives are rejected in a filter function, attached
- * only to geometries that have any. */
+ * culling, so culled triangles are rejected in a filter function, attached
+ * only to geometries that have any.  Spheres are user geometry hit by the
+ * project's own test (geom/shapes.h), which solves in double: Embree's
+ * float sphere misses walls of radius 10^5 by a hundredth of a unit. */
 #include "geom/accel_internal.h"
 
 #include <embree3/rtcore.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "geom/shapes.h"
 #include "scene/mesh.h"
 #include "util/error.h"
 
@@ -59,19 +63,59 @@ static void cull_filter(const struct RTCFilterFunctionNArguments *args)
                 args->valid[i] = 0;
             continue;
         }
+        /* The parts' triangles (spheres cull in their own test). */
         const rs_part *p = &m->rs->parts[m->part_of_prim[prim]];
         if (!p->culled)
             continue;
-        if (m->kind == GEOM_TRIANGLES) {
-            facing = p->n;
-        } else {
-            vec3f o = f3(ray[0 * n + i], ray[1 * n + i], ray[2 * n + i]);
-            float t = ray[8 * n + i];
-            facing = f3_sub(f3_madd(o, d, t), p->p0);
-        }
+        facing = p->n;
         if (f3_dot(facing, d) >= 0.0f)
             args->valid[i] = 0;
     }
+}
+
+/* Spheres as user geometry: bounds, nearest and any hit of one ray (the
+ * backend casts single rays: N is 1). */
+static void sphere_bounds(const struct RTCBoundsFunctionArguments *args)
+{
+    const geom_map *m = args->geometryUserPtr;
+    const rs_part *p = &m->rs->parts[m->part_of_prim[args->primID]];
+    /* Widened by a float's rounding of the far coordinates. */
+    float r = p->radius * (1.0f + 1e-6f);
+    struct RTCBounds *b = args->bounds_o;
+    b->lower_x = p->p0.x - r; b->lower_y = p->p0.y - r; b->lower_z = p->p0.z - r;
+    b->upper_x = p->p0.x + r; b->upper_y = p->p0.y + r; b->upper_z = p->p0.z + r;
+}
+
+static void sphere_intersect(const struct RTCIntersectFunctionNArguments *args)
+{
+    if (!args->valid[0])
+        return;
+    const geom_map *m = args->geometryUserPtr;
+    const rs_part *p = &m->rs->parts[m->part_of_prim[args->primID]];
+    struct RTCRayHit *rh = (struct RTCRayHit *)args->rayhit;
+    vec3f o = f3(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z);
+    vec3f d = f3(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z);
+    float t = shape_sphere_hit(p, o, d, 0.0f, rh->ray.tfar);
+    if (t < 0.0f)
+        return;
+    rh->ray.tfar = t;
+    rh->hit.geomID = args->geomID;
+    rh->hit.primID = args->primID;
+    rh->hit.instID[0] = args->context->instID[0];
+}
+
+static void sphere_occluded(const struct RTCOccludedFunctionNArguments *args)
+{
+    if (!args->valid[0])
+        return;
+    const geom_map *m = args->geometryUserPtr;
+    const rs_part *p = &m->rs->parts[m->part_of_prim[args->primID]];
+    struct RTCRay *r = (struct RTCRay *)args->ray;
+    vec3f o = f3(r->org_x, r->org_y, r->org_z), d = f3(r->dir_x, r->dir_y, r->dir_z);
+    /* tfar is inclusive here (embree_any lowered it by one float). */
+    float tmax = nextafterf(r->tfar, INFINITY);
+    if (shape_sphere_hit(p, o, d, 0.0f, tmax) >= 0.0f)
+        r->tfar = -INFINITY;
 }
 
 static void embree_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
@@ -157,8 +201,8 @@ static int add_geometry(embree_accel *e, const rscene *rs, int layer, int kind)
         return 0;
     RTCGeometry g = rtcNewGeometry(e->device, kind == GEOM_TRIANGLES
                                                   ? RTC_GEOMETRY_TYPE_TRIANGLE
-                                                  : RTC_GEOMETRY_TYPE_SPHERE_POINT);
-    float *vb;
+                                                  : RTC_GEOMETRY_TYPE_USER);
+    float *vb = NULL;
     unsigned *ib = NULL;
     if (kind == GEOM_TRIANGLES) {
         vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -166,10 +210,12 @@ static int add_geometry(embree_accel *e, const rscene *rs, int layer, int kind)
         ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                      3 * sizeof(unsigned), (size_t)count);
     } else {
-        vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                     4 * sizeof(float), (size_t)count);
+        rtcSetGeometryUserPrimitiveCount(g, (unsigned)count);
+        rtcSetGeometryBoundsFunction(g, sphere_bounds, NULL);
+        rtcSetGeometryIntersectFunction(g, sphere_intersect);
+        rtcSetGeometryOccludedFunction(g, sphere_occluded);
     }
-    if (!vb || (kind == GEOM_TRIANGLES && !ib)) {
+    if (kind == GEOM_TRIANGLES && (!vb || !ib)) {
         rtcReleaseGeometry(g);
         free(map);
         return 0;
@@ -188,18 +234,17 @@ static int add_geometry(embree_accel *e, const rscene *rs, int layer, int kind)
                 vb[(k * 3 + j) * 3 + 2] = v[j].z;
                 ib[k * 3 + j] = (unsigned)(k * 3 + j);
             }
-        } else {
-            vb[k * 4 + 0] = p->p0.x;
-            vb[k * 4 + 1] = p->p0.y;
-            vb[k * 4 + 2] = p->p0.z;
-            vb[k * 4 + 3] = p->radius;
         }
         k++;
     }
     geom_map *gm = &e->map[layer][kind];
     gm->rs = rs;
     gm->kind = kind;
-    if (any_culled) {
+    /* The spheres' callbacks read the map (and cull themselves). */
+    gm->part_of_prim = map;
+    if (kind == GEOM_SPHERES)
+        rtcSetGeometryUserData(g, gm);
+    else if (any_culled) {
         rtcSetGeometryUserData(g, gm);
         rtcSetGeometryIntersectFilterFunction(g, cull_filter);
         rtcSetGeometryOccludedFilterFunction(g, cull_filter);
@@ -208,7 +253,6 @@ static int add_geometry(embree_accel *e, const rscene *rs, int layer, int kind)
     /* The geometry id is the kind, so hits index map[layer] directly. */
     rtcAttachGeometryByID(e->scene[layer], g, (unsigned)kind);
     rtcReleaseGeometry(g);
-    gm->part_of_prim = map;
     e->empty[layer] = 0;
     return 1;
 }

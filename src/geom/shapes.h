@@ -56,28 +56,34 @@ static inline float shape_triangle_hit(const rs_part *p, vec3f o, vec3f d,
 }
 
 /* Geometric form of the quadratic, which keeps precision when the ray
- * starts far away (Haines et al., Ray Tracing Gems ch. 7). */
+ * starts far away (Haines et al., Ray Tracing Gems ch. 7), in double: a
+ * sphere used as a wall (radius 10^5 around a room 100 wide, as smallpt
+ * builds its room) has r^2 = 10^10, where a float's unit in the last
+ * place is 1024 and the roots would be off by whole units. */
 static inline float shape_sphere_hit(const rs_part *p, vec3f o, vec3f d,
                                      float tmin, float tmax)
 {
-    vec3f f = f3_sub(o, p->p0);
-    float b = -f3_dot(f, d);
-    vec3f l = f3_madd(f, d, b);
-    float r2 = p->radius * p->radius;
-    float disc = r2 - f3_dot(l, l);
-    if (disc < 0.0f)
+    double fx = (double)o.x - p->p0.x, fy = (double)o.y - p->p0.y, fz = (double)o.z - p->p0.z;
+    double b = -(fx * d.x + fy * d.y + fz * d.z);
+    double lx = fx + d.x * b, ly = fy + d.y * b, lz = fz + d.z * b;
+    double r2 = (double)p->radius * p->radius;
+    double disc = r2 - (lx * lx + ly * ly + lz * lz);
+    if (disc < 0.0)
         return -1.0f;
-    float c = f3_dot(f, f) - r2;
-    float q = b + copysignf(sqrtf(disc), b);
-    float t0 = q != 0.0f ? c / q : 0.0f, t1 = q;
+    double c = fx * fx + fy * fy + fz * fz - r2;
+    double q = b + copysign(sqrt(disc), b);
+    double t0 = q != 0.0 ? c / q : 0.0, t1 = q;
     if (t0 > t1) {
-        float tmp = t0; t0 = t1; t1 = tmp;
+        double tmp = t0; t0 = t1; t1 = tmp;
     }
-    if (t0 > tmin && t0 < tmax)
-        return t0;
+    /* Compared as the floats returned, so that a query up to a hit's
+     * distance does not find that hit before it. */
+    float f0 = (float)t0, f1 = (float)t1;
+    if (f0 > tmin && f0 < tmax)
+        return f0;
     /* The far root is the inside of the sphere, hidden when culled. */
-    if (!p->culled && t1 > tmin && t1 < tmax)
-        return t1;
+    if (!p->culled && f1 > tmin && f1 < tmax)
+        return f1;
     return -1.0f;
 }
 
@@ -90,6 +96,40 @@ static inline float shape_hit(const rs_part *p, vec3f o, vec3f d, float tmin,
     case SHAPE_PLANE: return shape_plane_hit(p, o, d, tmin, tmax);
     default: return -1.0f;
     }
+}
+
+/* The point where a ray meets the part, put back onto its surface where
+ * that matters.  o + t d carries the rounding of t and of the product,
+ * which grows with the ray's length and the coordinates' size: on a floor
+ * seen from afar it reaches the few units in the last place by which
+ * ray_offset moves a point off a surface near a zero coordinate, and rays
+ * from the point would meet the surface again.  A sphere's point is put
+ * back onto it in double (as pbrt-v4 reprojects its sphere hits), a
+ * plane's onto the plane (exact for the axis-aligned planes rooms are made
+ * of).  Triangles keep o + t d: projecting them in double cost the Cornell
+ * box 14% of its time, and their hits are where the offset was made for. */
+/* Out of line: the renderers' loops keep their registers for their own
+ * values (the path tracer's loop is allocated as one region). */
+__attribute__((noinline, cold)) static vec3f shape_sphere_point(const rs_part *p, vec3f x)
+{
+    double vx = (double)x.x - p->p0.x, vy = (double)x.y - p->p0.y, vz = (double)x.z - p->p0.z;
+    double len = sqrt(vx * vx + vy * vy + vz * vz);
+    if (!(len > 0.0))
+        return x;
+    double k = p->radius / len;
+    return f3((float)(p->p0.x + vx * k), (float)(p->p0.y + vy * k), (float)(p->p0.z + vz * k));
+}
+
+static inline vec3f shape_hit_point(const rs_part *p, vec3f o, vec3f d, float t)
+{
+    vec3f x = f3_madd(o, d, t);
+    if (p->shape == SHAPE_SPHERE)
+        return shape_sphere_point(p, x);
+    if (p->shape == SHAPE_PLANE) {
+        float e = f3_dot(p->n, x) - p->offset;
+        return f3_sub(x, f3_scale(p->n, e));
+    }
+    return x;
 }
 
 /* Geometric normal at point x on the part (unit, the part's front side). */

@@ -34,7 +34,7 @@ vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
                 return p->background ? tr : f3_splat(0.0f);
             break;
         }
-        vec3f x = f3_madd(o, d, h.t);
+        vec3f x = shape_hit_point(p, o, d, h.t);
         vec3f ng = shape_normal(p, x);
         float c = f3_dot(ng, d);
         tr = f3_mul(tr, bsdf_pane_transmittance(m, fabsf(c)));

@@ -125,7 +125,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         }
         rs_part tri;
         const rs_part *p = rs_prim(rs, h.part, &tri);
-        vec3f x = f3_madd(o, d, h.t);
+        vec3f x = shape_hit_point(p, o, d, h.t);
         if (p->is_light) {
             if (counted) {
                 vec3f le = light_emitted(rs, p, x, d);
@@ -246,10 +246,11 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                  * and distance measured from x would graze the light and
                  * find it blocking itself. */
                 vec3f from = below ? ray_offset(x, f3_neg(n)) : x_out;
-                vec3f to_y = f3_sub(f3_madd(x, ls.wi, ls.dist), from);
+                vec3f y = f3_madd(x, ls.wi, ls.dist);
+                vec3f to_y = f3_sub(y, from);
                 float dist_y = f3_length(to_y);
                 vec3f dir_y = f3_scale(to_y, 1.0f / dist_y);
-                vec3f tr = accel_transmittance(rs, from, dir_y, dist_y * 0.9999f,
+                vec3f tr = accel_transmittance(rs, from, dir_y, shadow_ray_end(from, y, dist_y),
                                                lp->background);
                 if (!f3_is_black(tr)) {
                     if (bsdf_pdf > 0.0f) {

@@ -187,7 +187,7 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     if (p->is_light)
         return;
     const rs_object *m = &rs->objects[p->object];
-    vec3f xf = f3_madd(o, d, h.t);
+    vec3f xf = shape_hit_point(p, o, d, h.t);
     vec3f ngf = shape_normal(p, xf);
     int back = f3_dot(ngf, d) > 0.0f;
     vec3f nf = back ? f3_neg(ngf) : ngf;

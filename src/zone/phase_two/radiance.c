@@ -37,7 +37,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         return lo <= 0 ? f3_to_v3(zone_background(rs, d)) : v3(0, 0, 0);
     rs_part tmp;
     const rs_part *p = rs_prim(rs, h.part, &tmp);
-    vec3f xf = f3_madd(o, d, h.t);
+    vec3f xf = shape_hit_point(p, o, d, h.t);
     /* Lights that send caustic photons (caustic.h) are theirs to count
      * after a caustic target. */
     int photons = (flags & ZR_CAUSTIC_LIGHT) &&

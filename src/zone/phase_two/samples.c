@@ -111,7 +111,7 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
             *glint = 1;
         if (p->is_light)
             break;
-        vec3f x = f3_madd(o, d, h.t);
+        vec3f x = shape_hit_point(p, o, d, h.t);
         vec3f ng = shape_normal(p, x);
         vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
         if (m->weight[LOBE_DIFFUSE] > 0.0f && rs->point_light_count)

@@ -136,7 +136,7 @@ static void surface_of(const rscene *rs, const p2_sample *s, surface *sf)
 {
     sf->p = rs_prim(rs, s->part, &sf->tmp);
     sf->m = &rs->objects[sf->p->object];
-    sf->xf = f3_madd(s->o, s->d, s->t);
+    sf->xf = shape_hit_point(sf->p, s->o, s->d, s->t);
     vec3f ngf = shape_normal(sf->p, sf->xf);
     sf->back = f3_dot(ngf, s->d) > 0.0f;
     sf->nf = sf->back ? f3_neg(ngf) : ngf;
