@@ -542,8 +542,7 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
             vec3f d = f3_scale(to, 1.0f / dist);
             if (lp->shape == SHAPE_SPHERE)
                 dist = sphere_entry(lp, xo, d, dist);
-            s = accel_transmittance(c->rs, xo, d,
-                                    shadow_ray_end(xo, f3_madd(xo, d, dist), dist), lp->background);
+            s = accel_transmittance(c->rs, xo, d, dist * 0.9999f, lp->background);
         }
         if (keep)
             seen[at++] = s;
@@ -605,9 +604,8 @@ vec3 direct_irradiance_rgb(const direct_ctx *c, int light, vec3 x, vec3 n, int r
         vec3f nf = f3((float)n.x, (float)n.y, (float)n.z);
         vec3f df = f3((float)d.x, (float)d.y, (float)d.z);
         float dist = f3_length(df);
-        vec3f xo = ray_offset(xf, nf);
-        vec3f s = accel_transmittance(c->rs, xo, f3_scale(df, 1.0f / dist),
-                                      shadow_ray_end(xo, f3_add(xf, df), dist), lp->background);
+        vec3f s = accel_transmittance(c->rs, ray_offset(xf, nf), f3_scale(df, 1.0f / dist),
+                                      dist * 0.9999f, lp->background);
         return v3(s.x * cosx / d2, s.y * cosx / d2, s.z * cosx / d2);
     }
 
