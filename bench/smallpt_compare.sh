@@ -24,7 +24,7 @@ import re, sys
 s = open(sys.argv[1]).read()
 def sub(pat, rep):
     global s
-    s2, n = re.subn(pat, rep, s, flags=re.S)
+    s2, n = re.subn(pat, lambda m: rep, s, flags=re.S)
     if n != 1:
         sys.exit("smallpt_compare: the source does not look like smallpt.cpp (%s)" % pat)
     s = s2
