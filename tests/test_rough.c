@@ -5,6 +5,7 @@
  * out here (in double, independently of the renderer), which checks the
  * lobes' values, their densities and the MIS between them and the sun. */
 #include "test_support.h"
+#include "fresnel.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -34,17 +35,6 @@ static double lambda(d3 w, double a)
 {
     double z2 = w.z * w.z;
     return 0.5 * (sqrt(1 + a * a * (1 - z2) / z2) - 1);
-}
-
-static double fresnel(double c, double eta_i, double eta_t)
-{
-    double s2 = eta_i * eta_i / (eta_t * eta_t) * (1 - c * c);
-    if (s2 >= 1)
-        return 1;
-    double ct = sqrt(1 - s2);
-    double rs = (eta_i * c - eta_t * ct) / (eta_i * c + eta_t * ct);
-    double rp = (eta_t * c - eta_i * ct) / (eta_t * c + eta_i * ct);
-    return 0.5 * (rs * rs + rp * rp);
 }
 
 /* f |cos_i| of the white rough interface from wo (z > 0) to wi, without

@@ -75,10 +75,15 @@ static void cull_filter(const struct RTCFilterFunctionNArguments *args)
 
 /* Spheres as user geometry: bounds, nearest and any hit of one ray (the
  * backend casts single rays: N is 1). */
+static const rs_part *sphere_part(const void *user, unsigned prim)
+{
+    const geom_map *m = user;
+    return &m->rs->parts[m->part_of_prim[prim]];
+}
+
 static void sphere_bounds(const struct RTCBoundsFunctionArguments *args)
 {
-    const geom_map *m = args->geometryUserPtr;
-    const rs_part *p = &m->rs->parts[m->part_of_prim[args->primID]];
+    const rs_part *p = sphere_part(args->geometryUserPtr, args->primID);
     /* Widened by a float's rounding of the far coordinates. */
     float r = p->radius * (1.0f + 1e-6f);
     struct RTCBounds *b = args->bounds_o;
@@ -90,8 +95,7 @@ static void sphere_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     if (!args->valid[0])
         return;
-    const geom_map *m = args->geometryUserPtr;
-    const rs_part *p = &m->rs->parts[m->part_of_prim[args->primID]];
+    const rs_part *p = sphere_part(args->geometryUserPtr, args->primID);
     struct RTCRayHit *rh = (struct RTCRayHit *)args->rayhit;
     vec3f o = f3(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z);
     vec3f d = f3(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z);
@@ -108,8 +112,7 @@ static void sphere_occluded(const struct RTCOccludedFunctionNArguments *args)
 {
     if (!args->valid[0])
         return;
-    const geom_map *m = args->geometryUserPtr;
-    const rs_part *p = &m->rs->parts[m->part_of_prim[args->primID]];
+    const rs_part *p = sphere_part(args->geometryUserPtr, args->primID);
     struct RTCRay *r = (struct RTCRay *)args->ray;
     vec3f o = f3(r->org_x, r->org_y, r->org_z), d = f3(r->dir_x, r->dir_y, r->dir_z);
     /* tfar is inclusive here (embree_any lowered it by one float). */

@@ -106,25 +106,21 @@ static inline float shape_hit(const rs_part *p, vec3f o, vec3f d, float tmin,
  * from the point would meet the surface again.  A sphere's point is put
  * back onto it in double (as pbrt-v4 reprojects its sphere hits), a
  * plane's onto the plane (exact for the axis-aligned planes rooms are made
- * of).  Triangles keep o + t d: projecting them in double cost the Cornell
- * box 14% of its time, and their hits are where the offset was made for. */
-/* Out of line: the renderers' loops keep their registers for their own
- * values (the path tracer's loop is allocated as one region). */
-__attribute__((noinline, cold)) static vec3f shape_sphere_point(const rs_part *p, vec3f x)
-{
-    double vx = (double)x.x - p->p0.x, vy = (double)x.y - p->p0.y, vz = (double)x.z - p->p0.z;
-    double len = sqrt(vx * vx + vy * vy + vz * vz);
-    if (!(len > 0.0))
-        return x;
-    double k = p->radius / len;
-    return f3((float)(p->p0.x + vx * k), (float)(p->p0.y + vy * k), (float)(p->p0.z + vz * k));
-}
-
+ * of).  Triangles keep o + t d, the case ray_offset's margins were made
+ * for. */
 static inline vec3f shape_hit_point(const rs_part *p, vec3f o, vec3f d, float t)
 {
     vec3f x = f3_madd(o, d, t);
-    if (p->shape == SHAPE_SPHERE)
-        return shape_sphere_point(p, x);
+    if (p->shape == SHAPE_SPHERE) {
+        double vx = (double)x.x - p->p0.x, vy = (double)x.y - p->p0.y,
+               vz = (double)x.z - p->p0.z;
+        double len = sqrt(vx * vx + vy * vy + vz * vz);
+        if (!(len > 0.0))
+            return x;
+        double k = p->radius / len;
+        return f3((float)(p->p0.x + vx * k), (float)(p->p0.y + vy * k),
+                  (float)(p->p0.z + vz * k));
+    }
     if (p->shape == SHAPE_PLANE) {
         float e = f3_dot(p->n, x) - p->offset;
         return f3_sub(x, f3_scale(p->n, e));

@@ -44,7 +44,7 @@ static inline float ggx_g2(vec3f wo, vec3f wi, float alpha)
 }
 
 /* A microfacet normal visible from wo (wo.z > 0), with density
- * ggx_vndf_pdf: stretch to the hemisphere configuration, sample the
+ * G1(wo) max(0, wo.h) D(h) / wo.z: stretch to the hemisphere configuration, sample the
  * projected hemisphere seen from there, and unstretch. */
 static inline vec3f ggx_sample_vndf(vec3f wo, float alpha, const float u[2])
 {
@@ -61,12 +61,6 @@ static inline vec3f ggx_sample_vndf(vec3f wo, float alpha, const float u[2])
     vec3f nh = f3_add(f3_add(f3_scale(t1, p1), f3_scale(t2, p2)),
                       f3_scale(vh, sqrtf(f_max0(1.0f - p1 * p1 - p2 * p2))));
     return f3_normalize(f3(alpha * nh.x, alpha * nh.y, f_max(nh.z, 1e-6f)));
-}
-
-/* Density of ggx_sample_vndf choosing h: G1(wo) max(0, wo.h) D(h) / wo.z. */
-static inline float ggx_vndf_pdf(vec3f wo, vec3f h, float alpha)
-{
-    return ggx_g1(wo, alpha) * f_max0(f3_dot(wo, h)) * ggx_d(h, alpha) / wo.z;
 }
 
 /* Single-scattering albedo of a white rough mirror (F = 1) seen at cos_o,
