@@ -166,7 +166,7 @@ static void test_roughness_zero(void **state)
 /* A camera with a narrow view at a point of the plane y = 0 from direction
  * wo (world), the sun of half-angle th around direction s; the material's
  * lobe (reflecting or refractive), roughness r.  Returns the image mean. */
-static double sun_on_plane(d3 wo, d3 s, double th, int glass, double r)
+static double sun_on_plane(zt_method method, d3 wo, d3 s, double th, int glass, double r)
 {
     char text[1536];
     snprintf(text, sizeof text,
@@ -178,7 +178,7 @@ static double sun_on_plane(d3 wo, d3 s, double th, int glass, double r)
              "\"fov\": 0.5, \"gridresolution\": [8, 8]}}",
              s.x, s.y, s.z, 2 * th * 180 / PI, !glass, glass, r, 3 * wo.x, 3 * wo.y, 3 * wo.z);
     zt_scene *sc = test_scene_text(text, "rough_sun");
-    zt_image *im = test_render_level(sc, ZT_METHOD_PATH, 1, 1, 256);
+    zt_image *im = test_render_level(sc, method, 1, 1, 256);
     double sum = 0;
     int n = 3 * im->width * im->height;
     for (int i = 0; i < n; i++)
@@ -188,40 +188,71 @@ static double sun_on_plane(d3 wo, d3 s, double th, int glass, double r)
     return sum / n;
 }
 
+static const char *const method_name[] = {"path", "zone"};
+static const zt_method methods[] = {ZT_METHOD_PATH, ZT_METHOD_ZONE};
+
+/* Both renderers: the zone tracer's rough lobes weigh their directions
+ * against light samples of the sun (phase_two/rough.c) as the path tracer
+ * does. */
 static void test_sun_rough_mirror(void **state)
 {
     (void)state;
+    for (int mi = 0; mi < 2; mi++) {
     /* Roughness 0.2 under a sun of 5 degrees: the lobe is narrower than
      * the disc, so both the lobe's and the sun's samples carry light. */
     const double cases[][2] = {{0.2, 5}, {0.5, 0.53}, {1.0, 0.53}};
     for (int i = 0; i < 3; i++) {
         double r = cases[i][0], th = cases[i][1] / 2 * PI / 180;
         d3 s = unit(mk(0.3, 0.8, 0.2)), wo = unit(mk(-0.3, 0.7, -0.1));
-        double got = sun_on_plane(wo, s, th, 0, r);
+        double got = sun_on_plane(methods[mi], wo, s, th, 0, r);
         /* The plane's frame: z is the world's y. */
         double want = sun_through_lobe(mk(wo.x, wo.z, wo.y), mk(s.x, s.z, s.y), th, 100, r * r, 0, 1);
-        print_message("sun on a rough mirror, roughness %.1f, sun %.2f deg: %.5g, formula %.5g\n",
-                      r, cases[i][1], got, want);
+        print_message("%s: sun on a rough mirror, roughness %.1f, sun %.2f deg: %.5g, formula %.5g\n",
+                      method_name[mi], r, cases[i][1], got, want);
         assert_true(fabs(got / want - 1) < 0.01);
+    }
     }
 }
 
 static void test_sun_through_rough_glass(void **state)
 {
     (void)state;
+    for (int mi = 0; mi < 2; mi++) {
     /* The camera below the interface, in the lighter medium, the sun above
      * it: radiance leaving the denser side carries (1 / 1.5)^2. */
     const double rough[] = {0.3, 0.7};
     for (int i = 0; i < 2; i++) {
         double th = 0.53 / 2 * PI / 180;
         d3 s = unit(mk(0.2, 0.9, 0.1)), wo = unit(mk(0.1, -0.8, 0.3));
-        double got = sun_on_plane(wo, s, th, 1, rough[i]);
+        double got = sun_on_plane(methods[mi], wo, s, th, 1, rough[i]);
         /* Frame: z is the world's -y (the camera's side). */
         double want = sun_through_lobe(mk(wo.x, wo.z, -wo.y), mk(s.x, s.z, -s.y), th, 100,
                                        rough[i] * rough[i], 1.5, 1 / 2.25);
-        print_message("sun through rough glass, roughness %.1f: %.5g, formula %.5g\n", rough[i],
-                      got, want);
+        print_message("%s: sun through rough glass, roughness %.1f: %.5g, formula %.5g\n",
+                      method_name[mi], rough[i], got, want);
         assert_true(fabs(got / want - 1) < 0.01);
+    }
+    }
+}
+
+/* The zone tracer's white furnace: a rough mirror sphere under a white sky
+ * sends it back whole at its first bounce (the lobe's lost energy put
+ * back), read over the lobe's directions. */
+static void test_zone_furnace(void **state)
+{
+    (void)state;
+    const double rough[] = {0.1, 0.3, 0.6, 1.0};
+    for (int i = 0; i < 4; i++) {
+        char text[1024];
+        snprintf(text, sizeof text, SPHERE_SCENE, 1, 0, rough[i]);
+        zt_scene *s = test_scene_text(text, "rough_furnace");
+        zt_image *im = test_render_level(s, ZT_METHOD_ZONE, 1, 1, 1);
+        double mean = sphere_mean(im);
+        print_message("zone: white furnace, rough reflecting sphere, roughness %.1f: %.4f\n",
+                      rough[i], mean);
+        assert_true(fabs(mean - 1) < 0.01);
+        zt_image_release(im);
+        zt_scene_release(s);
     }
 }
 
@@ -232,6 +263,7 @@ int main(void)
         cmocka_unit_test(test_roughness_zero),
         cmocka_unit_test(test_sun_rough_mirror),
         cmocka_unit_test(test_sun_through_rough_glass),
+        cmocka_unit_test(test_zone_furnace),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -63,6 +63,36 @@ static const char *sky_box_text =
 
 static zt_scene *scene_from(const char *text) { return test_scene_text(text, "box.json"); }
 
+/* The box with rough lobes: the mirror sphere at roughness 0.3, the glass
+ * at 0.2, the metallic triangle at 0.5 (phase_two/rough.c). */
+static const char *rough_box_text(void)
+{
+    static char text[8192];
+    if (text[0])
+        return text;
+    const char *from[3] = {"[0.9, 0.9, 0.9]}", "\"refractiveindex\": 1.5}",
+                           "\"refractiveindex\": 0.3}"};
+    const char *to[3] = {"[0.9, 0.9, 0.9], \"roughness\": 0.3}",
+                         "\"refractiveindex\": 1.5, \"roughness\": 0.2}",
+                         "\"refractiveindex\": 0.3, \"roughness\": 0.5}"};
+    const char *src = box_text;
+    size_t len = 0;
+    while (*src) {
+        int k = 0;
+        while (k < 3 && strncmp(src, from[k], strlen(from[k])) != 0)
+            k++;
+        if (k < 3) {
+            len += (size_t)snprintf(text + len, sizeof text - len, "%s", to[k]);
+            src += strlen(from[k]);
+        } else {
+            text[len++] = *src++;
+        }
+    }
+    text[len] = 0;
+    assert_non_null(strstr(text, "\"roughness\": 0.5"));
+    return text;
+}
+
 /* The box without its specular things, and three slats of a mesh near the
  * floor: diffuse light of levels >= 2 on the slats is gathered (gather.c),
  * which every rule below must keep. */
@@ -210,6 +240,7 @@ static void test_strategies_identical(void **state)
     check_strategies(box_text, 2, 1);
     check_strategies(sky_box_text, 2, -1);
     check_strategies(mesh_box_text(), 3, -1);
+    check_strategies(rough_box_text(), 3, -1);
 }
 
 /* The per-zone terms add up to one zone_radiance call per sample; the
@@ -239,6 +270,7 @@ static void test_terms_sum_to_shading(void **state)
     check_terms(box_text, 3, 0);
     check_terms(sky_box_text, 2, 0);
     check_terms(mesh_box_text(), 3, 1);
+    check_terms(rough_box_text(), 3, 0);
 }
 
 /* The images of levels 0..o.depth, rendered one by one, add up to `all`

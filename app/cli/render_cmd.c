@@ -377,9 +377,8 @@ static void print_scene(const render_job *job)
         fprintf(stderr, "note: %d model materials have a roughness, which is not read from "
                 "model files yet: their metal, mirror and glass lobes are smooth\n",
                 info.rough_materials);
-    if (info.rough_lobes && o->method == ZT_METHOD_ZONE)
-        fprintf(stderr, "note: %d materials are rough; the zone tracer renders their lobes "
-                "smooth (docs/zone-tracer.md, \"Rough lobes\")\n", info.rough_lobes);
+    if (info.rough_lobes)
+        fprintf(stderr, "rough materials: %d (GGX lobes)\n", info.rough_lobes);
     if (info.panes)
         fprintf(stderr, "note: %d materials are thin panes: light crosses them undeviated "
                 "(docs/scene-format.md, \"thin\")\n", info.panes);

@@ -59,8 +59,7 @@ typedef struct zt_scene_info {
     int rough_materials; /* model files' materials whose roughness is not
                             read yet (their lobes are smooth) */
     int rough_lobes;  /* scene materials with a roughness above 0 and a
-                         metallic, reflecting or refractive lobe: GGX in
-                         the path tracer, smooth in the zone tracer */
+                         metallic, reflecting or refractive lobe (GGX) */
     int missing_textures; /* textures a model names but that are missing or
                              cannot be decoded (left out: base colour only) */
     char texture_problem[160]; /* the first of them and why */

@@ -157,6 +157,28 @@ void bsdf_eval_rough(const rs_object *m, const shading_frame *f, vec3f wo, vec3f
     pdf[LOBE_REFRACTIVE] = w * co * g1;
 }
 
+int bsdf_sample_rough_lobes(const rs_object *m, unsigned lobes, const shading_frame *f, vec3f wo,
+                            float u_lobe, float u_split, const float u2[2], float eta_i,
+                            float eta_t, bsdf_sample *out)
+{
+    float total = 0.0f;
+    for (int k = 0; k < LOBE_COUNT; k++)
+        if ((lobes >> k & 1u) && bsdf_lobe_rough(m, k))
+            total += m->weight[k];
+    if (!(total > 0.0f))
+        return 0;
+    int lobe = -1;
+    float acc = 0.0f;
+    for (int k = 0; k < LOBE_COUNT; k++)
+        if ((lobes >> k & 1u) && bsdf_lobe_rough(m, k)) {
+            lobe = k;
+            acc += m->weight[k];
+            if (u_lobe * total < acc)
+                break;
+        }
+    return bsdf_sample_rough(m, lobe, f, wo, u_split, u2, eta_i, eta_t, out);
+}
+
 static int bsdf_sample_rough(const rs_object *m, int lobe, const shading_frame *f, vec3f wo,
                              float u_split, const float u2[2], float eta_i, float eta_t,
                              bsdf_sample *out)

@@ -96,6 +96,14 @@ static inline int bsdf_lobe_rough(const rs_object *m, int k)
 void bsdf_eval_rough(const rs_object *m, const shading_frame *f, vec3f wo, vec3f wi,
                      float eta_i, float eta_t, float fcos[LOBE_COUNT], float pdf[LOBE_COUNT]);
 
+/* Samples a direction from m's rough lobes among `lobes` (a mask of 1 << k),
+ * one of them chosen by u_lobe in proportion to its weight; the rest as
+ * for bsdf_sample_material.  Only out->wi, ->transmit and ->delta are of
+ * use: bsdf_eval_rough gives every lobe's value and density there. */
+int bsdf_sample_rough_lobes(const rs_object *m, unsigned lobes, const shading_frame *f, vec3f wo,
+                            float u_lobe, float u_split, const float u2[2], float eta_i,
+                            float eta_t, bsdf_sample *out);
+
 /* Samples the material at a point with frame f (f->n facing the side of
  * wo, the direction towards the previous vertex).  u_lobe picks the lobe,
  * u_split reflection or transmission of the dielectric, u2 the diffuse

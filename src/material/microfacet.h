@@ -19,9 +19,12 @@
 
 static inline float ggx_d(vec3f h, float alpha)
 {
+    /* a2 / (pi (z^2 (a2 - 1) + 1)^2) for unit h, written with the
+     * tangential part so that at alpha^2 below float's resolution of 1 the
+     * peak stays 1 / (pi a2) instead of a division by zero. */
     float a2 = alpha * alpha;
-    float t = h.z * h.z * (a2 - 1.0f) + 1.0f;
-    return a2 / (3.14159265358979f * t * t);
+    float t = (h.x * h.x + h.y * h.y) / a2 + h.z * h.z;
+    return 1.0f / (3.14159265358979f * a2 * t * t);
 }
 
 /* Smith's Lambda for direction w (w.z != 0). */

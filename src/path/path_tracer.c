@@ -16,6 +16,7 @@
 #include "geom/shapes.h"
 #include "geom/transmittance.h"
 #include "light/distant.h"
+#include "light/mis.h"
 #include "light/light_sample.h"
 #include "material/bsdf.h"
 #include "render/prim.h"
@@ -36,18 +37,6 @@
 #define DISTANT_PAIR (1 + STRATIFIED_VERTICES * PAIRS_PER_VERTEX)
 _Static_assert(DISTANT_PAIR + 1 == PATH_SEEDED_PAIRS,
                "the pixel holds the seed of every stratified pair");
-
-static inline float power_heuristic(float a, float b)
-{
-    float a2 = a * a, b2 = b * b;
-    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
-}
-
-/* power_heuristic(a, b) / a for a > 0: one division instead of two. */
-static inline float power_heuristic_over(float a, float b)
-{
-    return a / (a * a + b * b);
-}
 
 /* The refractive objects the path is inside, innermost last: deciding
  * entering/leaving by object identity makes shells of two surfaces work. */

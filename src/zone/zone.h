@@ -86,6 +86,10 @@ typedef struct zone_quality {
     int mesh_gather_pixel;  /* directions a pixel's samples on a mesh
                                share (gather.c) */
     int mesh_gather_sample; /* and that each of them takes at least */
+    int rough_pixel;    /* directions (and light samples) a pixel's
+                           samples share at a rough lobe (rough.c) */
+    int rough_light_pixel; /* the same for light of level 0 */
+    int rough_sample;   /* and that each of them takes at least */
 } zone_quality;
 
 typedef struct zone_forest {
@@ -163,6 +167,9 @@ vec3 *zone_gather_directions(int n);
 typedef struct zone_gather_slot {
     uint32_t pixel;         /* y * width + x */
     uint16_t index, count;  /* the sample's place among them; 0, 0: none */
+    uint16_t sample, samples; /* its place among all of the pixel's samples
+                                 (an edge pixel's too): rough lobes share
+                                 the pixel's stretch by it (rough.c) */
 } zone_gather_slot;
 
 typedef struct zone_trace {
@@ -172,7 +179,17 @@ typedef struct zone_trace {
     /* Exact direct light at a camera sample that shares the fallback's
      * rays with its neighbours (direct_irradiance_split), 0: alone. */
     int light_split;
-    zone_gather_slot gather; /* the camera sample's (zone_gather_irradiance) */
+    zone_gather_slot gather; /* the camera sample's (zone_gather_irradiance
+                                and its rough lobes' directions) */
+    /* Set by a rough lobe for the next ray it traces (zone_radiance resets
+     * it): the lobe's density of that direction, and the point it left, so
+     * that the light it meets is weighed against the lobe's light samples
+     * (rough.c); 0: no weighing. */
+    float mis_pdf;
+    vec3f mis_from;
+    /* The camera sample's weight in its pixel (rough.c shares the pixel's
+     * directions by it); 0 on rays that are not a camera sample's. */
+    double sample_share;
 } zone_trace;
 
 /* Irradiance of level `level` at point x (normal n) on side `side` of
@@ -224,5 +241,33 @@ enum {
 };
 vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count);
+
+/* A surface a ray has met, as its rough lobes see it. */
+typedef struct zone_rough_at {
+    const rs_object *m;
+    int part;
+    vec3f x;            /* the hit point */
+    vec3f ng;           /* the geometric normal, facing the ray's side */
+    vec3f ns;           /* the shading normal, on the same side */
+    vec3 color;         /* the albedo there (textured) */
+    vec3f d;            /* the arriving ray's direction */
+    float eta_i, eta_t; /* the indices on the ray's side and beyond */
+    int object;         /* the part's object (media.h's identity) */
+    int entering;       /* whether the ray enters it */
+    const int *media;   /* the glass the ray is in (media.h) */
+    int media_count;
+} zone_rough_at;
+
+/* The radiance that the rough lobes of s->m among `lobes` (a mask of
+ * 1 << LOBE_k) send back along the ray, of the levels lo..hi arriving at
+ * the surface (one below the levels they pass on): the lobe sampled over
+ * fixed directions, and light of level 0 also by light samples, the two
+ * weighed by multiple importance sampling (phase_two/rough.c). */
+vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, int lo, int hi,
+                         int flags);
+/* One direction *wi from s's rough lobes, chosen by a hash of the point
+ * and the arriving direction, and *value, their f cos over its density
+ * (the colour apart): how a caustic photon goes on.  0: none. */
+int zone_rough_scatter(const zone_rough_at *s, vec3f *wi, float *value);
 
 #endif

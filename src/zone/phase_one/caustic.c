@@ -170,6 +170,44 @@ static int on_target(const rscene *rs, const target *tg, int prim)
     return prim >= rs->part_count && rs_mesh_of(rs, prim) == &rs->meshes[tg->mesh];
 }
 
+static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
+                   int glint, const target *first, const int *media, int media_count);
+
+/* A photon's flux leaving part p's rough lobes at xf (nf facing it). */
+static void rough_on(tracer *t, const rs_part *p, int part, vec3f xf, vec3f nf, vec3f d,
+                     vec3 flux, double share, int k, const int *media, int media_count)
+{
+    const rscene *rs = t->rs;
+    const rs_object *m = &rs->objects[p->object];
+    int entering = media_count == 0 || media[media_count - 1] != p->object;
+    float eta_i = media_count ? rs->objects[media[media_count - 1]].ior : 1.0f;
+    float eta_t = entering ? m->ior : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
+    rs_shade sh = {nf, m->color};
+    if (rs_needs_shade(rs, part, m))
+        rs_shade_at(rs, part, p, m, xf, nf, &sh);
+    zone_rough_at at = {m,     part,  xf,       nf,         sh.ns, f3_to_v3(sh.albedo), d,
+                        eta_i, eta_t, p->object, entering, media, media_count};
+    vec3f wi;
+    float value;
+    if (!zone_rough_scatter(&at, &wi, &value))
+        return;
+    int through = f3_dot(wi, nf) < 0.0f;
+    /* Flux crosses the surface without the radiance's (eta_i/eta_t)^2. */
+    if (through)
+        value *= (eta_t / eta_i) * (eta_t / eta_i);
+    vec3 out = v3_scale(v3_mul(flux, at.color), value);
+    double sp = share * value * v3_max(at.color);
+    if (sp < BRANCH_MIN)
+        return;
+    if (!through) {
+        follow(t, ray_offset(xf, nf), wi, out, sp, k + 1, 0, NULL, media, media_count);
+        return;
+    }
+    int next[MEDIA_MAX];
+    int nc = media_cross(media, media_count, p->object, entering, next);
+    follow(t, ray_offset(xf, f3_neg(nf)), wi, out, sp, k + 1, 0, NULL, next, nc);
+}
+
 /* Follows flux along (o, d) after k specular events.  `first`: the part
  * the ray must hit first (-1: any).  `glint`: the path so far is one
  * reflection off the outside of a glint sphere, which glint.c accounts for
@@ -215,6 +253,16 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     float wt = m->weight[LOBE_REFRACTIVE];
     if (wm <= 0.0f && wr <= 0.0f && wt <= 0.0f)
         return;
+    if (m->rough) {
+        /* Rough lobes send the photon on in one direction drawn from them
+         * (zone_rough_scatter), the smooth ones below the rest. */
+        rough_on(t, p, h.part, xf, nf, d, flux, share, k, media, media_count);
+        wm = wr = 0.0f;
+        if (!m->thin)
+            wt = 0.0f;
+        if (wt <= 0.0f)
+            return;
+    }
     /* The same lobes and weights as zone_radiance, seen from the light's
      * side (Fresnel and Schlick are reciprocal). */
     float cos_o = -f3_dot(nf, d);

@@ -20,8 +20,10 @@ int glint_sphere(const rscene *rs, int i)
     if (p->is_light || p->shape != SHAPE_SPHERE)
         return 0;
     const rs_object *m = &rs->objects[p->object];
-    return m->weight[LOBE_REFLECTING] > 0.0f || m->weight[LOBE_METALLIC] > 0.0f ||
-           m->weight[LOBE_REFRACTIVE] > 0.0f;
+    /* A rough sphere spreads a light's image over its lobe: its photons
+     * carry that light (caustic.c). */
+    return !m->rough && (m->weight[LOBE_REFLECTING] > 0.0f || m->weight[LOBE_METALLIC] > 0.0f ||
+                         m->weight[LOBE_REFRACTIVE] > 0.0f);
 }
 
 /* In the plane of c, x and y, the angle phi of s runs from x's direction

@@ -51,6 +51,11 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
      * light at their hits: the integral smooths what the nodes blur). */
     int save = t->light_split;
     t->light_split = 0;
+    /* Rough lobes its rays meet take one direction each. */
+    zone_gather_slot slot = t->gather;
+    double share = t->sample_share;
+    t->gather = (zone_gather_slot){0};
+    t->sample_share = 0.0;
     vec3 sum = v3(0, 0, 0);
     for (int k = 0; k < k_max; k++) {
         double u, v;
@@ -65,5 +70,7 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
                                         ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0));
     }
     t->light_split = save;
+    t->gather = slot;
+    t->sample_share = share;
     return v3_scale(sum, 3.14159265358979 / k_max);
 }

@@ -15,6 +15,7 @@
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
 #include "light/light_sample.h"
+#include "light/mis.h"
 #include "material/bsdf.h"
 #include "render/prim.h"
 #include "util/vec3_convert.h"
@@ -24,17 +25,32 @@
 
 
 
+/* An escaping ray's radiance; light from far away weighed against a rough
+ * lobe's light samples when mis (the lobe's density) is set. */
+static vec3 background(const rscene *rs, vec3f d, float mis)
+{
+    if (!rs->distant.any || !(mis > 0.0f))
+        return f3_to_v3(zone_background(rs, d));
+    float pdf;
+    vec3f l = distant_eval(&rs->distant, d, &pdf);
+    return f3_to_v3(f3_add(rs->sky, f3_scale(l, power_heuristic(mis, pdf))));
+}
+
 vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count)
 {
     int exact_direct = flags & ZR_EXACT_DIRECT;
+    /* A rough lobe's direction: its light of level 0 is weighed against
+     * the lobe's light samples (rough.c). */
+    float mis = t->mis_pdf;
+    t->mis_pdf = 0.0f;
     if (hi < 0 || lo > hi)
         return v3(0, 0, 0);
     const rscene *rs = &t->r->rs;
     hit h = accel_intersect(rs, o, d);
     t->rays++;
     if (h.part < 0)
-        return lo <= 0 ? f3_to_v3(zone_background(rs, d)) : v3(0, 0, 0);
+        return lo <= 0 ? background(rs, d, mis) : v3(0, 0, 0);
     rs_part tmp;
     const rs_part *p = rs_prim(rs, h.part, &tmp);
     vec3f xf = shape_hit_point(p, o, d, h.t);
@@ -44,10 +60,16 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                   (p->shape == SHAPE_TRIANGLE || p->shape == SHAPE_SPHERE);
     /* Light parts seen by the camera are measured by coverage; mesh lights
      * are shaded on the samples. */
-    if (p->is_light)
-        return lo <= 0 && !((flags & ZR_NO_EMISSION) && h.part < rs->part_count) && !photons
-                   ? f3_to_v3(light_emitted(rs, p, xf, d))
-                   : v3(0, 0, 0);
+    if (p->is_light) {
+        if (lo > 0 || ((flags & ZR_NO_EMISSION) && h.part < rs->part_count) || photons)
+            return v3(0, 0, 0);
+        vec3f le = light_emitted(rs, p, xf, d);
+        if (mis > 0.0f && p->select_pdf > 0.0f)
+            le = f3_scale(le, power_heuristic(
+                                  mis, light_pdf(p, t->mis_from, d,
+                                                 f3_length(f3_sub(xf, t->mis_from)))));
+        return f3_to_v3(le);
+    }
     const rs_object *m = &rs->objects[p->object];
     if (hi < 1 && !m->thin) /* a pane passes level 0 on */
         return v3(0, 0, 0);
@@ -80,8 +102,14 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         out = v3_add(out, v3_scale(v3_mul(color, e), m->weight[LOBE_DIFFUSE] / 3.14159265358979));
     }
 
+    /* Smooth lobes here; rough ones (m->rough: all but a pane's) below. */
     float wm = m->weight[LOBE_METALLIC], wr = m->weight[LOBE_REFLECTING];
     float wt = m->weight[LOBE_REFRACTIVE];
+    if (m->rough) {
+        wm = wr = 0.0f;
+        if (!m->thin)
+            wt = 0.0f;
+    }
     if ((hi >= 1 || m->thin) && (wm > 0.0f || wr > 0.0f || wt > 0.0f)) {
         vec3f ng_facing = nf;
         nf = sh.ns;
@@ -120,6 +148,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
             out = v3_add(out, v3_scale(v3_mul(color, l), k_refl));
         }
         if (!v3_is_black(pass)) {
+            t->mis_pdf = mis; /* crossing a pane, the ray goes on */
             vec3 l = zone_radiance(t, ray_offset(xf, f3_neg(ng_facing)), d, lo, hi,
                                    flags, media, media_count);
             out = v3_add(out, v3_mul(pass, l));
@@ -133,6 +162,15 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                                    exact_direct | cflags, next, nc);
             out = v3_add(out, v3_scale(v3_mul(color, l), k_tran * eta * eta));
         }
+    }
+    if (m->rough && hi >= 1) {
+        int entering = media_count == 0 || media[media_count - 1] != p->object;
+        zone_rough_at at = {m, h.part, xf, back ? f3_neg(ngf) : ngf, sh.ns, color, d,
+                            media_count ? rs->objects[media[media_count - 1]].ior : 1.0f,
+                            1.0f, p->object, entering, media, media_count};
+        at.eta_t = entering ? m->ior
+                            : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
+        out = v3_add(out, zone_rough_radiance(t, &at, ~0u, lo - 1, hi - 1, flags));
     }
     return out;
 }

@@ -181,7 +181,7 @@ static void note_light(const rscene *rs, seen_lights *s, int part)
 static zone_gather_slot gather_slot(const p2_ctx *c, int px, int py, int index, int count)
 {
     zone_gather_slot g = {(uint32_t)py * (uint32_t)c->c.width + (uint32_t)px, (uint16_t)index,
-                          (uint16_t)count};
+                          (uint16_t)count, (uint16_t)index, (uint16_t)count};
     return g;
 }
 
@@ -334,6 +334,7 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
             lights->cover[l] = (double)count / cells;
         }
     /* The subset's samples, weighted by their group's coverage. */
+    size_t first_sample = row->sample_count;
     for (int i = 0; i < cells; i++) {
         int k = e->group_of[i];
         if (!cover_shaded(quasi, n, shade, i))
@@ -376,6 +377,13 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
         if (!push_sample(rs, row, org, dir, e->hits[best], (double)e->group_count[k] / cells, 0,
                          gather_slot(c, px, py, 0, 1)))
             return 0;
+    }
+    /* Each sample's place among the pixel's (its gathers keep a whole set
+     * of their own). */
+    size_t n_pushed = row->sample_count - first_sample;
+    for (size_t i = 0; i < n_pushed; i++) {
+        row->samples[first_sample + i].gather.sample = (uint16_t)i;
+        row->samples[first_sample + i].gather.samples = (uint16_t)n_pushed;
     }
     return 1;
 }

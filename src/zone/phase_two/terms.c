@@ -185,6 +185,14 @@ static vec3 specular_value(zone_trace *t, const p2_term *term, const p2_sample *
     vec3f out_o = ray_offset(sf.xf, sf.nf);
     double k_refl = 0, k_tran = 0;
     float eta_i = 1.0f, eta_t = m->ior; /* the camera is in vacuum: entering */
+    int lobe = term->kind == ZONE_MIRROR     ? LOBE_REFLECTING
+               : term->kind == ZONE_METALLIC ? LOBE_METALLIC
+                                             : LOBE_REFRACTIVE;
+    if (bsdf_lobe_rough(m, lobe)) {
+        zone_rough_at at = {m,     s->part, sf.xf, sf.nf, ns, sf.color, d, eta_i, eta_t,
+                            sf.p->object, 1, NULL, 0};
+        return zone_rough_radiance(t, &at, 1u << lobe, l - 1, l - 1, ZR_EXACT_DIRECT);
+    }
     switch (term->kind) {
     case ZONE_MIRROR:
         k_refl = m->weight[LOBE_REFLECTING];
@@ -306,6 +314,7 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
             continue;
         t->light_split = s->light_split;
         t->gather = s->gather;
+        t->sample_share = s->w;
         vec3 v;
         switch (term->type) {
         case P2_EMIT: {
@@ -321,7 +330,8 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
         add(acc, s->w, v);
     }
     t->light_split = 0;
-    t->gather = (zone_gather_slot){0, 0, 0};
+    t->gather = (zone_gather_slot){0};
+    t->sample_share = 0.0;
 }
 
 void p2_reference(const p2_ctx *c, zone_trace *t, const p2_pixel *px, double acc[3])
@@ -334,9 +344,11 @@ void p2_reference(const p2_ctx *c, zone_trace *t, const p2_pixel *px, double acc
     for (int i = 0; i < px->n; i++) {
         t->light_split = px->s[i].light_split;
         t->gather = px->s[i].gather;
+        t->sample_share = px->s[i].w;
         add(acc, px->s[i].w,
             zone_radiance(t, px->s[i].o, px->s[i].d, c->lo, c->hi, SHADE_FLAGS, NULL, 0));
     }
     t->light_split = 0;
-    t->gather = (zone_gather_slot){0, 0, 0};
+    t->gather = (zone_gather_slot){0};
+    t->sample_share = 0.0;
 }

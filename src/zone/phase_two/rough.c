@@ -1,0 +1,310 @@
+/* Rough lobes (GGX, material/microfacet.h) in the zone tracer.
+ *
+ * A smooth lobe passes on the light of one direction, which a ray reads
+ * from the forest.  A rough lobe passes on an integral over its spread:
+ *
+ *   L(wo) = sum over the lobes k of  int f_k(wo, wi) L_{l-1}(wi) |cos| dwi,
+ *
+ * estimated here over a fixed sequence of directions drawn from the lobes
+ * (visible normals), each reading the level below from the forest as the
+ * smooth lobe's ray does.  Light of level 0 (lights, the sun, a map) is
+ * small and bright: it takes its own, larger set of directions (a ray
+ * each, no forest) and as many light samples (the path tracer's
+ * next-event choice, from the same kind of sequence), the two weighed by
+ * the power heuristic, so that a lobe far narrower than a light and a
+ * light far smaller than a lobe both come out right.  The lobes share one density, the weighted mixture that
+ * chooses among them, and a direction's value is the sum of every lobe's
+ * f cos over it (one-sample MIS over the lobes: a rough glass's reflection
+ * and transmission count wherever either sends light).
+ *
+ * How many directions: a camera sample's share of its pixel's
+ * q.rough_pixel (level 0: q.rough_light_pixel), by its weight in the
+ * pixel, as the mesh gathers share theirs (gather.c): the pixel's
+ * own stretch of Roberts' R2 sequence, sample i of n taking points i,
+ * i + n, ...; at least q.rough_sample.  A ray that meets a rough lobe on
+ * the way (a reflection seen in a rough mirror, a gather's ray, Phase
+ * One's) takes one direction, from a point of the sequence chosen by a
+ * hash of where it is: deterministic, and unrelated between neighbours.
+ * The image stays deterministic; its error is the quadrature's. */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#include "geom/accel.h"
+#include "geom/ray_offset.h"
+#include "geom/transmittance.h"
+#include "light/light_sample.h"
+#include "light/mis.h"
+#include "material/bsdf.h"
+#include "render/prim.h"
+#include "util/r2.h"
+#include "util/vec3_convert.h"
+#include "zone/phase_one/caustic.h"
+#include "zone/phase_two/media.h"
+#include "zone/zone.h"
+
+/* Additive recurrences for the one-dimensional choices (which lobe,
+ * reflect or refract, which light), on irrationals unrelated to R2's. */
+#define GOLDEN 0.61803398874989484820
+#define SQRT2_1 0.41421356237309504880
+#define SQRT3_1 0.73205080756887729353
+/* The light samples read R2 this far along: a fixed shift of the lobe's
+ * points. */
+#define LIGHT_SHIFT 0.5
+
+static float frac_f(double x)
+{
+    double f = x - floor(x);
+    return f < 1.0 ? (float)f : 0.99999994f;
+}
+
+/* A point of the sequence for a ray that meets a rough lobe on its way. */
+static double hashed_index(vec3f x, vec3f d)
+{
+    uint32_t b[6];
+    const float v[6] = {x.x, x.y, x.z, d.x, d.y, d.z};
+    memcpy(b, v, sizeof b);
+    uint32_t h = 2166136261u;
+    for (int i = 0; i < 6; i++) {
+        h ^= b[i];
+        h *= 16777619u;
+        h ^= h >> 15;
+    }
+    return (double)(h & 0xffffffu);
+}
+
+/* The lobes' f cos summed (colour apart) and their mixture's density of
+ * direction wi; 0 when wi lies on the other side of the geometric normal
+ * than of the shading normal (light would leak). */
+static float lobes_eval(const zone_rough_at *s, const shading_frame *fr, unsigned lobes,
+                        float weight_sum, vec3f wi, float *pdf)
+{
+    *pdf = 0.0f;
+    if ((f3_dot(s->ng, wi) > 0.0f) != (f3_dot(fr->n, wi) > 0.0f))
+        return 0.0f;
+    float fcos[LOBE_COUNT], p[LOBE_COUNT], f = 0.0f, sum = 0.0f;
+    bsdf_eval_rough(s->m, fr, f3_neg(s->d), wi, s->eta_i, s->eta_t, fcos, p);
+    for (int k = 0; k < LOBE_COUNT; k++)
+        if (lobes >> k & 1u) {
+            f += fcos[k];
+            sum += p[k];
+        }
+    *pdf = sum / weight_sum;
+    return f;
+}
+
+/* Level 0 by light samples: the lights (not under ZR_NO_CAUSTIC: photons
+ * carry their light by specular surfaces there) and light from far away. */
+static vec3 light_samples(zone_trace *t, const zone_rough_at *s, const shading_frame *fr,
+                          unsigned lobes, float weight_sum, double j, int flags)
+{
+    const rscene *rs = &t->r->rs;
+    vec3 out = v3(0, 0, 0);
+    double u, v;
+    r2_point(j + LIGHT_SHIFT, &u, &v);
+    const float u2[2] = {(float)u, (float)v};
+    light_sample ls;
+    if (!(flags & ZR_NO_CAUSTIC) && rs->light_count > 0 &&
+        light_sample_point(rs, s->x, frac_f(0.5 + j * SQRT3_1), u2, &ls) && !f3_is_black(ls.li)) {
+        float pdf, f = lobes_eval(s, fr, lobes, weight_sum, ls.wi, &pdf);
+        if (f > 0.0f) {
+            int below = f3_dot(s->ng, ls.wi) < 0.0f;
+            vec3f from = ray_offset(s->x, below ? f3_neg(s->ng) : s->ng);
+            vec3f y = f3_madd(s->x, ls.wi, ls.dist);
+            vec3f to_y = f3_sub(y, from);
+            float dist_y = f3_length(to_y);
+            rs_part tmp;
+            const rs_part *lp = rs_prim(rs, ls.part, &tmp);
+            vec3f tr = accel_transmittance(rs, from, f3_scale(to_y, 1.0f / dist_y),
+                                           shadow_ray_end(from, y, dist_y), lp->background);
+            t->rays++;
+            float w = ls.delta ? 1.0f / ls.pdf : power_heuristic_over(ls.pdf, pdf);
+            out = v3_add(out, f3_to_v3(f3_scale(f3_mul(ls.li, tr), f * w)));
+        }
+    }
+    vec3f wi, li;
+    float far_pdf;
+    float u_pick = rs->distant.map && rs->distant.sun ? frac_f(0.5 + j * SQRT2_1 + 0.25) : 0.0f;
+    if (rs->distant.any && distant_sample(&rs->distant, u_pick, u2, &wi, &far_pdf, &li) &&
+        !f3_is_black(li)) {
+        float pdf, f = lobes_eval(s, fr, lobes, weight_sum, wi, &pdf);
+        if (f > 0.0f) {
+            int below = f3_dot(s->ng, wi) < 0.0f;
+            vec3f tr = accel_transmittance(rs, ray_offset(s->x, below ? f3_neg(s->ng) : s->ng),
+                                           wi, FLT_MAX, 1);
+            t->rays++;
+            out = v3_add(out, f3_to_v3(f3_scale(f3_mul(li, tr),
+                                                f * power_heuristic_over(far_pdf, pdf))));
+        }
+    }
+    return out;
+}
+
+/* The rough lobes among `lobes` that m has, and the sum of their weights. */
+static unsigned rough_lobes(const rs_object *m, unsigned lobes, float *weight_sum)
+{
+    *weight_sum = 0.0f;
+    for (int k = 0; k < LOBE_COUNT; k++) {
+        if (!bsdf_lobe_rough(m, k))
+            lobes &= ~(1u << k);
+        if (lobes >> k & 1u)
+            *weight_sum += m->weight[k];
+    }
+    return lobes;
+}
+
+static void frame_of(const zone_rough_at *s, shading_frame *fr)
+{
+    fr->n = s->ns;
+    f3_basis(fr->n, &fr->t, &fr->b);
+}
+
+/* One direction from the lobes, by point j of the sequence: *value is the
+ * lobes' f cos over the mixture's density there (colour apart), *pdf that
+ * density (0 for the straight line of an index-matched glass, whose value
+ * is 1). */
+static int scatter(const zone_rough_at *s, const shading_frame *fr, unsigned lobes,
+                   float weight_sum, double j, vec3f *wi, float *pdf, float *value)
+{
+    double u, v;
+    r2_point(j, &u, &v);
+    const float u2[2] = {(float)u, (float)v};
+    bsdf_sample bs;
+    if (!bsdf_sample_rough_lobes(s->m, lobes, fr, f3_neg(s->d), frac_f(0.5 + j * GOLDEN),
+                                 frac_f(0.5 + j * SQRT2_1), u2, s->eta_i, s->eta_t, &bs))
+        return 0;
+    *wi = bs.wi;
+    if (bs.delta) {
+        *pdf = 0.0f;
+        *value = 1.0f;
+        return 1;
+    }
+    float f = lobes_eval(s, fr, lobes, weight_sum, bs.wi, pdf);
+    if (!(f > 0.0f) || !(*pdf > 0.0f))
+        return 0;
+    *value = f / *pdf;
+    return 1;
+}
+
+int zone_rough_scatter(const zone_rough_at *s, vec3f *wi, float *value)
+{
+    float weight_sum, pdf;
+    unsigned lobes = rough_lobes(s->m, ~0u, &weight_sum);
+    if (!(weight_sum > 0.0f))
+        return 0;
+    shading_frame fr;
+    frame_of(s, &fr);
+    return scatter(s, &fr, lobes, weight_sum, hashed_index(s->x, s->d), wi, &pdf, value);
+}
+
+/* The lobes' light of levels lo..hi along one direction (point j): f cos
+ * over the density times the forest's radiance there; light of level 0
+ * weighed against the light samples. */
+static vec3 lobe_ray(zone_trace *t, const zone_rough_at *s, const shading_frame *fr,
+                     unsigned lobes, float weight_sum, double j, int lo, int hi, int flags)
+{
+    vec3f wi;
+    float pdf, f;
+    if (!scatter(s, fr, lobes, weight_sum, j, &wi, &pdf, &f))
+        return v3(0, 0, 0);
+    int through = f3_dot(s->ng, wi) < 0.0f;
+    vec3f o = ray_offset(s->x, through ? f3_neg(s->ng) : s->ng);
+    int next[MEDIA_MAX];
+    const int *media = s->media;
+    int media_count = s->media_count;
+    if (through) {
+        media_count = media_cross(s->media, s->media_count, s->object, s->entering, next);
+        media = next;
+    }
+    t->mis_pdf = lo == 0 ? pdf : 0.0f;
+    t->mis_from = s->x;
+    return v3_scale(zone_radiance(t, o, wi, lo, hi, flags, media, media_count), f);
+}
+
+/* A camera sample's count of a pixel's `per_pixel` points: by its weight
+ * in the pixel, at least `least`. */
+static int sample_count(int per_pixel, double share, int least)
+{
+    int k = (int)(per_pixel * share + 0.5);
+    return k > least ? k : least;
+}
+
+/* Where a sample's points lie in the sequence: a camera sample's pixel has
+ * its own stretch, which its samples take interleaved (sample i of n the
+ * points i, i + n, i + 2n, ...), so that the pixel as a whole integrates
+ * over evenly spread points; a ray on its way starts where a hash of the
+ * point says. */
+typedef struct seq {
+    double first, step;
+} seq;
+
+static seq sequence(const zone_gather_slot *slot, int camera, int per_pixel,
+                    const zone_rough_at *s)
+{
+    if (!camera)
+        return (seq){hashed_index(s->x, s->d), 1.0};
+    return (seq){(double)slot->pixel * per_pixel + slot->sample + 1, slot->samples};
+}
+
+vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, int lo, int hi,
+                         int flags)
+{
+    const rs_object *m = s->m;
+    const rscene *rs = &t->r->rs;
+    float weight_sum;
+    lobes = rough_lobes(m, lobes, &weight_sum);
+    if (!(weight_sum > 0.0f) || hi < 0 || lo > hi)
+        return v3(0, 0, 0);
+    if (lo < 0)
+        lo = 0;
+    shading_frame fr;
+    frame_of(s, &fr);
+
+    /* The directions: the camera sample's share of its pixel's, or one
+     * from a point of the sequence a hash of where it is picks. */
+    zone_gather_slot slot = t->gather;
+    double share = t->sample_share;
+    const zone_quality *q = &t->f->q;
+    int camera = share > 0.0 && slot.samples > 0;
+    int k_max = camera ? sample_count(q->rough_pixel, share, q->rough_sample) : 1;
+    int exact_direct = flags & ZR_EXACT_DIRECT;
+    int cflags = 0;
+    if (flags & ZR_NO_CAUSTIC)
+        cflags = ZR_NO_CAUSTIC | (caustic_target(rs, s->part) ? ZR_CAUSTIC_LIGHT : 0);
+    /* Rays from here on are not the camera sample's: what they meet takes
+     * one direction each of the sample's stretch, and exact direct light
+     * at their ends is a point's own (no shared split). */
+    int save_split = t->light_split;
+    t->light_split = 0;
+    vec3 sum = v3(0, 0, 0);
+    t->sample_share = 0.0;
+    /* Level 0: its own, larger set of directions and light samples: they
+     * read no forest (a ray each), and a light's highlight in a glossy lobe
+     * is small and bright. */
+    if (lo == 0) {
+        int k0 = camera ? sample_count(q->rough_light_pixel, share, q->rough_sample) : 1;
+        seq sq = sequence(&slot, camera, q->rough_light_pixel, s);
+        vec3 l0 = v3(0, 0, 0);
+        for (int k = 0; k < k0; k++) {
+            double j = sq.first + sq.step * k;
+            l0 = v3_add(l0, light_samples(t, s, &fr, lobes, weight_sum, j, flags));
+            l0 = v3_add(l0, lobe_ray(t, s, &fr, lobes, weight_sum, j, 0, 0, exact_direct | cflags));
+        }
+        sum = v3_add(sum, v3_scale(l0, (double)k_max / k0));
+        lo = 1;
+    }
+    /* What the lobe's rays meet: a mesh gathers a share of the camera
+     * sample's directions (gather.c), a rough lobe takes one. */
+    seq sq = sequence(&slot, camera, q->rough_pixel, s);
+    for (int k = 0; k < k_max && lo <= hi; k++) {
+        if (camera)
+            t->gather = (zone_gather_slot){slot.pixel, (uint16_t)k, (uint16_t)k_max, 0, 0};
+        sum = v3_add(sum, lobe_ray(t, s, &fr, lobes, weight_sum, sq.first + sq.step * k, lo, hi,
+                                   exact_direct | cflags));
+    }
+    t->gather = slot;
+    t->sample_share = share;
+    t->mis_pdf = 0.0f;
+    t->light_split = save_split;
+    return v3_scale(v3_mul(s->color, sum), 1.0 / k_max);
+}
