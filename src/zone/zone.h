@@ -99,13 +99,19 @@ typedef struct zone_forest {
     surface_nodes sn;
     int map_levels;     /* irradiance levels E_0 .. E_{map_levels-1} */
     float *e;           /* [level][node][rgb] */
+    /* What e holds of light that came from the lights by way of specular
+     * surfaces alone (caustic photons, glint images), kept apart where
+     * the scene has meshes (whose camera samples gather) and specular
+     * lobes: the gathers' rays see all other light, and add this
+     * from the sample's own nodes (gather.c).  NULL otherwise. */
+    float *c;           /* [level][node][rgb] */
     occluder_index occ;
     direct_ctx direct;
     sender_tree light_tree; /* the lights, when there are many */
     zone_quality q;
     int need_gather;    /* some light arrives by specular surfaces */
-    int mesh_gather;    /* camera samples on meshes gather their diffuse
-                           light of levels >= 2 (zone_gather_irradiance) */
+    int specular;       /* some object has a metallic, reflecting or
+                           refractive lobe */
     int sky;            /* the sky is not black: E_0 gathers it */
     /* An environment map's gather: directions drawn from it by importance
      * (world frame) and each one's radiance / (density x count); and the
@@ -195,6 +201,10 @@ typedef struct zone_trace {
 /* Irradiance of level `level` at point x (normal n) on side `side` of
  * primitive prim, read from the nodes. */
 vec3 zone_map_read(const zone_forest *f, const rscene *rs, int level, int prim, int side, vec3 x);
+/* The same from the light by way of specular surfaces alone (f->c; 0
+ * where it is not kept apart). */
+vec3 zone_specular_map_read(const zone_forest *f, const rscene *rs, int level, int prim,
+                            int side, vec3 x);
 
 /* The radiance of an escaping ray in direction d: the sky's colour or map,
  * and the sun. */
@@ -213,9 +223,9 @@ vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n);
 
 /* Whether a camera path's diffuse light of levels >= 2 at primitive prim
  * is gathered (zone_gather_irradiance) rather than read from its nodes. */
-static inline int zone_gathers(const zone_forest *f, const rscene *rs, int prim)
+static inline int zone_gathers(const rscene *rs, int prim)
 {
-    return f->mesh_gather && prim >= rs->part_count;
+    return prim >= rs->part_count;
 }
 /* Irradiance of level `level` (>= 1) at x on a mesh (nf: the geometric
  * normal on the side seen, n: the shading normal), gathered from the

@@ -190,6 +190,10 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
         w_bytes(&w, f->sn.live, (size_t)f->sn.node_count);
         w_f32s(&w, f->sn.pos, (size_t)f->sn.node_count * 3);
         w_f32s(&w, f->e, (size_t)f->map_levels * f->sn.node_count * 3);
+        /* The caustics' and glints' part, where it is kept apart. */
+        w_i32(&w, f->c != NULL);
+        if (f->c)
+            w_f32s(&w, f->c, (size_t)f->map_levels * f->sn.node_count * 3);
     }
     uint64_t size = (uint64_t)w.n + 8;
     if (!w.failed)
@@ -563,14 +567,21 @@ zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *
         int oom = 0;
         float *pos = r_f32s(&rb, nn * 3, &oom);
         f->e = r_f32s(&rb, (size_t)levels * nn * 3, &oom);
+        int apart = r_i32(&rb);
+        if (apart == 1)
+            f->c = r_f32s(&rb, (size_t)levels * nn * 3, &oom);
         if (oom) {
             free(pos);
             st = zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
             goto done;
         }
-        if (!live || !pos || !f->e) {
+        /* Kept apart exactly when this build keeps it (phase_one.c). */
+        int want = f->specular && r->rs.mesh_count > 0;
+        if (!live || !pos || !f->e || apart != want || (apart && !f->c)) {
             free(pos);
-            st = ZT_ERR_PARSE;
+            st = apart != want && live && pos && f->e
+                     ? corrupt(err, path, "its caustic maps do not match the scene's")
+                     : ZT_ERR_PARSE;
             goto done;
         }
         float *reach = node_life_reach(&f->sn, &r->rs);
@@ -588,7 +599,7 @@ zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *
         }
         free(reach);
         for (size_t k = 0; k < (size_t)levels * nn * 3; k++)
-            bad |= !isfinite(f->e[k]);
+            bad |= !isfinite(f->e[k]) || (f->c && !isfinite(f->c[k]));
         if (bad) {
             free(pos);
             st = corrupt(err, path, "bad node values");

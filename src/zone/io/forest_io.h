@@ -9,7 +9,7 @@
 
 /* 12: the forest of nodes (docs/zone-tracer.md): zones per surface, lobe
  * and level, and the irradiance of every node. */
-#define FOREST_FILE_VERSION 12
+#define FOREST_FILE_VERSION 13
 
 /* Writes f (the forest of renderer r) to path, through a temporary file
  * renamed into place. */

@@ -308,16 +308,15 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
              o->weight[LOBE_REFRACTIVE] > 0))
             f->need_gather = 1;
     }
-    /* The gathers' rays see light by way of specular surfaces themselves,
-     * but not the caustic photons and glint images that the nodes hold:
-     * only where there are none (no specular lobe anywhere, so no glint
-     * spheres either). */
-    f->mesh_gather = 1;
-    for (int i = 0; i < rs->object_count && f->mesh_gather; i++) {
+    /* Where the scene has specular lobes, the light that the gathers on
+     * meshes leave out (caustics, glints) is kept apart in f->c for them
+     * to add (phase_one.c). */
+    f->specular = 0;
+    for (int i = 0; i < rs->object_count; i++) {
         const rs_object *o = &rs->objects[i];
         if (!o->is_light && (o->weight[LOBE_METALLIC] > 0 || o->weight[LOBE_REFLECTING] > 0 ||
                              o->weight[LOBE_REFRACTIVE] > 0))
-            f->mesh_gather = 0;
+            f->specular = 1;
     }
     f->sky = !f3_is_black(rs->sky) || rs->distant.map;
     if (rs->distant.map && !sky_map_directions(f, rs))
@@ -341,6 +340,7 @@ void zone_forest_free(zone_forest *f)
     surface_nodes_free(&f->sn);
     occluders_free(&f->occ);
     free(f->e);
+    free(f->c);
     free(f->glint_spheres);
     free(f->dirs);
     free(f->bounce_dirs);
@@ -351,19 +351,31 @@ void zone_forest_free(zone_forest *f)
     memset(f, 0, sizeof *f);
 }
 
-vec3 zone_map_read(const zone_forest *f, const rscene *rs, int level, int prim, int side, vec3 x)
+static vec3 map_read(const zone_forest *f, const float *map, const rscene *rs, int level,
+                     int prim, int side, vec3 x)
 {
-    if (level < 0 || level >= f->map_levels)
+    if (!map || level < 0 || level >= f->map_levels)
         return v3(0, 0, 0);
     int32_t node[4];
     float w[4];
     int n = surface_nodes_weights(&f->sn, rs, prim, side, x, node, w);
     vec3 e = v3(0, 0, 0);
     for (int k = 0; k < n; k++) {
-        const float *v = zone_e(f, level, node[k]);
+        const float *v = map + ((size_t)level * (size_t)f->sn.node_count + (size_t)node[k]) * 3;
         e = v3_add(e, v3_scale(v3(v[0], v[1], v[2]), w[k]));
     }
     return e;
+}
+
+vec3 zone_map_read(const zone_forest *f, const rscene *rs, int level, int prim, int side, vec3 x)
+{
+    return map_read(f, f->e, rs, level, prim, side, x);
+}
+
+vec3 zone_specular_map_read(const zone_forest *f, const rscene *rs, int level, int prim,
+                            int side, vec3 x)
+{
+    return map_read(f, f->c, rs, level, prim, side, x);
 }
 
 typedef struct light_leaf_ctx {

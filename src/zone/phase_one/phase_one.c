@@ -120,10 +120,7 @@ static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
 
 /* Mesh vertex nodes share a cut (node_groups.h) within GROUP_RADIUS x h
  * of their group's leader, normals within acos(GROUP_NORMAL) of its; a
- * member's cut then opens at most 1/GROUP_MORE of its limit more.  A
- * receiver on a mesh may open MESH_CUT_NUM / MESH_CUT_DEN times the
- * level's limit: a dense mesh puts many clusters close to its receivers
- * (Lightcuts' bounds carry no visibility), and the groups pay for it.
+ * member's cut then opens at most 1/GROUP_MORE of its limit more.
  * The engine room at depth 3, 512 x 512 (whole job, error per pixel / over
  * 4 x 4 blocks; single runs one after the other): without groups 54.5 s,
  * 1.68% / 1.014%, and with the mesh's limit x 1.5 76.7 s, 1.64% / 0.96%;
@@ -139,8 +136,6 @@ static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
  * for 1.391% / 0.967%: fewer opens save more time than the path tracer
  * would need to make up the added error. */
 #define GROUP_MORE 64
-#define MESH_CUT_NUM 5
-#define MESH_CUT_DEN 4
 /* From this level on (E_2: light that has bounced twice) a group's members
  * take their leader's value instead of a cut of their own.  Light that
  * bounced twice varies little over h/8, and re-estimating a 640-cluster
@@ -152,7 +147,7 @@ static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
  * and groups within h/4 or h/2 taking their leader's value 1.425% and
  * 1.498% for about 1 s less. */
 #define GROUP_COPY_LEVEL 2
-/* Where the camera's samples gather their light on meshes (gather.c), a
+/* The camera's samples gather their light on meshes (gather.c), so a
  * mesh's nodes are read only by the gathers' rays and as senders, which
  * average many of them: a receiver on a mesh opens a quarter of the
  * level's limit.  The engine room at depth 3, 512 x 512 (whole job, single
@@ -228,8 +223,7 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
     *gathered = bounce_gather(&t, f->bounce_dirs, f->q.gather, x, n, level, &lim, &e);
     if (!*gathered) {
         if (prim >= r->rs.part_count)
-            tk.max_cut = f->mesh_gather ? tc->max_cut / GATHERED_MESH_CUT_DIV
-                                        : tc->max_cut * MESH_CUT_NUM / MESH_CUT_DEN;
+            tk.max_cut = tc->max_cut / GATHERED_MESH_CUT_DIV;
         transfer_stats ts = {0};
         e = from ? transfer_irradiance_near(&tk, x, n, from, tk.max_cut / GROUP_MORE, &ts)
                  : transfer_irradiance(&tk, x, n, prim, &ts, rec);
@@ -501,6 +495,26 @@ static double phase_two_estimate(const zone_forest *f, const zt_renderer *r, dou
     return PHASE_TWO_FACTOR * level0 * points / f->sn.node_count;
 }
 
+/* The images of lights in glint spheres at the mesh nodes (E_1 holds them
+ * with the rest), into f->c for the gathers on meshes. */
+static void glints_apart(zone_forest *f, const zt_renderer *r)
+{
+    const surface_nodes *sn = &f->sn;
+    int threads = render_thread_count(r->options.threads);
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
+    for (int32_t k = 0; k < sn->node_count; k++) {
+        if (!sn->live[k] || sn->prim_of[k] < r->rs.part_count)
+            continue;
+        zone_trace t = {.f = f, .r = r};
+        vec3 n, x = node_point(sn, &r->rs, k, &n);
+        vec3 g = glint_irradiance(&t, f->glint_spheres, f->glint_count, x, n, f->q.glint_cuts);
+        float *c = f->c + ((size_t)f->sn.node_count + (size_t)k) * 3;
+        c[0] += (float)g.x;
+        c[1] += (float)g.y;
+        c[2] += (float)g.z;
+    }
+}
+
 zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
 {
     zt_status st = zone_forest_frame(f, r, err);
@@ -520,6 +534,14 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
         st = caustic_build(f, r, err);
         if (st != ZT_OK)
             return st;
+        /* What the caustics put there, kept apart for the gathers on
+         * meshes, which see everything else along their rays. */
+        if (f->specular && r->rs.mesh_count > 0) {
+            f->c = malloc((n + 3) * sizeof(float));
+            if (!f->c)
+                return zt_fail(err, ZT_ERR_MEMORY, "out of memory for %zu node values", n);
+            memcpy(f->c, f->e, (n + 3) * sizeof(float));
+        }
         mesh_rounds mr;
         if (!mesh_rounds_build(&mr, &f->sn, &r->rs, render_thread_count(r->options.threads)))
             return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the mesh's node rounds");
@@ -561,6 +583,8 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
             }
             if (level == 0)
                 phase_two = phase_two_estimate(f, r, render_clock() - t0);
+            if (level == 1 && f->c && f->glint_count)
+                glints_apart(f, r);
             built++;
         }
         sender_tree_free(&tree);

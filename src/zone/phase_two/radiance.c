@@ -93,8 +93,9 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                 e = v3_add(e, zone_lights_at(t, h.part, x, n));
                 if (t->f->sky)
                     e = v3_add(e, zone_sky_irradiance(t, x, n));
-            } else if (exact_direct && zone_gathers(t->f, rs, h.part)) {
+            } else if (exact_direct && zone_gathers(rs, h.part)) {
                 e = v3_add(e, zone_gather_irradiance(t, xf, nf, n, l - 1));
+                e = v3_add(e, zone_specular_map_read(t->f, rs, l - 1, h.part, back, x));
             } else {
                 e = v3_add(e, zone_map_read(t->f, rs, l - 1, h.part, back, x));
             }

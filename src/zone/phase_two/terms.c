@@ -165,9 +165,12 @@ static vec3 map_value(zone_trace *t, const p2_term *term, const p2_sample *s)
 {
     surface sf;
     surface_of(&t->r->rs, s, &sf);
-    vec3 e = zone_gathers(t->f, &t->r->rs, s->part)
-                 ? zone_gather_irradiance(t, sf.xf, sf.nf, sf.n, term->level - 1)
-                 : zone_map_read(t->f, &t->r->rs, term->level - 1, s->part, sf.back, sf.x);
+    const rscene *rs = &t->r->rs;
+    vec3 e = zone_gathers(rs, s->part)
+                 ? v3_add(zone_gather_irradiance(t, sf.xf, sf.nf, sf.n, term->level - 1),
+                          zone_specular_map_read(t->f, rs, term->level - 1, s->part, sf.back,
+                                                 sf.x))
+                 : zone_map_read(t->f, rs, term->level - 1, s->part, sf.back, sf.x);
     return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
 }
 
