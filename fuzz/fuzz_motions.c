@@ -1,5 +1,6 @@
-/* The motions loader on arbitrary text, then its check against a scene
- * and the motions applied at a few times. */
+/* The motions loader on arbitrary text, then its check against a scene,
+ * the motions applied at a few times and the camera path evaluated at
+ * its keys and between them. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,6 +48,17 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (int i = 0; s && i < 4; i++)
             zt_motions_apply(m, scene0, times[i], 1, s, &err);
         zt_scene_release(s);
+    }
+    int n = 0;
+    const zt_camera_key *k = zt_motions_camera_path(m, &n);
+    for (int i = 0; i < n && i < 16; i++) {
+        zt_camera cam;
+        double t[2] = {k[i].time, i + 1 < n ? 0.5 * (k[i].time + k[i + 1].time) : k[i].time + 1};
+        for (int j = 0; j < 2; j++) {
+            zt_error_clear(&err);
+            if (zt_motions_camera(m, scene0, t[j], &cam, &err) != ZT_OK && !err.message[0])
+                abort();
+        }
     }
     zt_motions_release(m);
     return 0;

@@ -244,6 +244,40 @@ static void test_animation(void **state)
     }
 }
 
+/* A camera path alone: each process builds its zone renderer once and
+ * renders its frames with it, the same bytes as one process. */
+static void test_camera_animation(void **state)
+{
+    (void)state;
+    const char *motions = test_write_file("job_camera.json",
+        "{\"motions\": [{\"camera\": \"path\", \"keys\": [\n"
+        "  {\"time\": 0, \"position\": [278, 273, -800], \"lookat\": [278, 273, 0], \"fov\": 37},\n"
+        "  {\"time\": 1, \"position\": [150, 300, -600], \"lookat\": [300, 200, 300], \"fov\": 45},\n"
+        "  {\"time\": 2, \"position\": [400, 200, -500], \"lookat\": [278, 273, 200]}]}]}\n");
+    char options[2048];
+    snprintf(options, sizeof options, "--motions '%s' --frames 5 --fps 2 --size 24x16 "
+             "--method zone --depth 2 --quality 0", motions);
+    char args[4096], *err = NULL;
+    snprintf(args, sizeof args, "render '%s' %s -o '%s/cam_single_%%d.pfm'", cornell(), options,
+             test_tmp_dir());
+    assert_int_equal(test_run_cli(args, &err), 0);
+    assert_non_null(strstr(err, "forest built once for 5 frames"));
+    free(err);
+    for (int ranks = 2; ranks <= 3; ranks++) {
+        snprintf(args, sizeof args, "render '%s' %s --threads 1 -o '%s/cam_%d_%%d.pfm'",
+                 cornell(), options, test_tmp_dir(), ranks);
+        assert_int_equal(run_job(ranks, args, &err), 0);
+        assert_non_null(strstr(err, "forest built once per process for 5 frames"));
+        free(err);
+        for (int k = 0; k < 5; k++) {
+            char a[1024], b[64];
+            snprintf(a, sizeof a, "%s/cam_single_%d.pfm", test_tmp_dir(), k);
+            snprintf(b, sizeof b, "cam_%d_%d.pfm", ranks, k);
+            test_assert_same_file(a, test_tmp_path(b));
+        }
+    }
+}
+
 /* The job ends with code, and its messages hold needle (and `also` when it
  * is not NULL). */
 static void expect_failure(int ranks, const char *args, int code, const char *needle,
@@ -318,6 +352,7 @@ int main(void)
         cmocka_unit_test(test_zone_forest),
         cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_animation),
+        cmocka_unit_test(test_camera_animation),
         cmocka_unit_test(test_failures),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,8 +1,9 @@
 /* The interactive viewer, driven by replay scripts in a virtual X server
  * (xvfb-run): its screenshots must show the scene, change when the camera
  * moves, darken when the light is switched off, show the HUD, and follow
- * the motions of the original dancingLights scene.  Skipped (with a
- * message) when xvfb-run is missing or the viewer is not built. */
+ * the motions of the original dancingLights scene and a camera path.
+ * Skipped (with a message) when xvfb-run is missing or the viewer is not
+ * built. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -285,6 +286,51 @@ static void test_zone_fallback(void **state)
     zt_image_release(b);
 }
 
+static void test_camera_path(void **state)
+{
+    (void)state;
+    if (!have_viewer())
+        skip();
+    /* The Cornell box's camera swings to the left wall and holds still
+     * there after 1 s: the view then converges to the one of a path that
+     * stands at that camera from the start. */
+    const char *key_end = "\"position\": [120, 300, -500], \"lookat\": [300, 200, 300], \"fov\": 45";
+    char text[1024], moving[512], still[512];
+    snprintf(text, sizeof text, "{\"motions\": [{\"camera\": \"path\", \"keys\": [\n"
+             "  {\"time\": 0, \"position\": [278, 273, -800], \"lookat\": [278, 273, 0], "
+             "\"fov\": 37},\n  {\"time\": 1, %s}]}]}\n", key_end);
+    snprintf(moving, sizeof moving, "%s", test_write_file("view_path.json", text));
+    snprintf(text, sizeof text, "{\"motions\": [{\"camera\": \"path\", \"keys\": [\n"
+             "  {\"time\": 0, %s},\n  {\"time\": 1, %s}]}]}\n", key_end, key_end);
+    snprintf(still, sizeof still, "%s", test_write_file("view_path_still.json", text));
+    char args[2048], *err = NULL;
+    snprintf(args, sizeof args, "'%s/scenes/cornell.json' --motions '%s' --size 64x64 --fps 20 "
+             "--script '0.05 screenshot path_start.png 1; 2.5 screenshot path_end.png 64; "
+             "2.6 quit' --exit-after 60", ZT_SOURCE_DIR, moving);
+    int rc = run_view(NULL, args, &err);
+    if (rc != 0)
+        fprintf(stderr, "exit %d:\n%s\n", rc, err ? err : "");
+    assert_int_equal(rc, 0);
+    free(err);
+    snprintf(args, sizeof args, "'%s/scenes/cornell.json' --motions '%s' --size 64x64 --fps 20 "
+             "--script '0.5 screenshot path_still.png 64; 0.6 quit' --exit-after 60",
+             ZT_SOURCE_DIR, still);
+    rc = run_view(NULL, args, &err);
+    if (rc != 0)
+        fprintf(stderr, "exit %d:\n%s\n", rc, err ? err : "");
+    assert_int_equal(rc, 0);
+    free(err);
+    zt_image *a = read_shot("path_start.png"), *b = read_shot("path_end.png");
+    zt_image *c = read_shot("path_still.png");
+    double moved = mean_abs_diff(a, c), arrived = mean_abs_diff(b, c);
+    fprintf(stderr, "camera path: start %.4f from the end's camera, end %.4f\n", moved, arrived);
+    assert_true(moved > 0.05);
+    assert_true(arrived < 0.2 * moved);
+    zt_image_release(a);
+    zt_image_release(b);
+    zt_image_release(c);
+}
+
 static void test_bad_arguments(void **state)
 {
     (void)state;
@@ -345,6 +391,7 @@ int main(void)
         cmocka_unit_test(test_dancing_lights),
         cmocka_unit_test(test_zone_method),
         cmocka_unit_test(test_zone_fallback),
+        cmocka_unit_test(test_camera_path),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,6 +1,7 @@
 /* zonetrace render --motions FILE: offline animation.  Frame k is the
  * scene at time T + k/F (T = --time, F = --fps), rendered with the same
- * options and seed, so the same command writes the same frames. */
+ * options and seed, so the same command writes the same frames.  When only
+ * the camera moves, one renderer serves all of a process's frames. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
 #include <stdlib.h>
@@ -77,22 +78,54 @@ typedef struct frame_report {
     int pad;
 } frame_report;
 
-/* Renders frame k (the scene at its time) into *img. */
-static zt_status render_frame(const zt_scene *scene0, const zt_motions *motions, zt_scene *scene,
-                              const zt_render_options *opt, const cli_animation *anim, int k,
-                              int verbose, zt_image **img, zt_render_stats *stats, zt_error *err)
+/* How a process makes its frames.  When no light and no thing moves, the
+ * scene is the same at every time: the renderer (its acceleration
+ * structure, the zone tracer's forest) is made at the process's first
+ * frame and later frames only set their camera, each giving the image
+ * zt_render gives for that camera.  Otherwise every frame renders the
+ * moved scene from scratch. */
+typedef struct frame_maker {
+    const zt_scene *scene0;
+    zt_scene *scene;           /* the scene at the frame's time */
+    const zt_motions *motions;
+    const cli_animation *anim;
+    zt_render_options opt;     /* its progress reports go to prog */
+    cli_progress prog;         /* as long-lived as a renderer keeping opt */
+    int verbose;
+    int keep;                  /* one renderer for every frame */
+    zt_renderer *r;
+    double build_seconds;      /* making r */
+} frame_maker;
+
+/* Renders frame k into *img.  The frame that makes the renderer counts the
+ * time it took in its stats. */
+static zt_status render_frame(frame_maker *fm, int k, zt_image **img, zt_render_stats *stats,
+                              zt_error *err)
 {
-    zt_status st = zt_motions_apply(motions, scene0, anim->time + k / anim->fps, opt->seed,
-                                    scene, err);
-    if (st != ZT_OK)
-        return st;
-    cli_progress prog;
-    cli_progress_init(&prog, verbose);
-    zt_render_options o = *opt;
-    o.progress = cli_progress_callback;
-    o.progress_user = &prog;
-    st = zt_render(scene, &o, img, stats, err);
-    cli_progress_finish(&prog);
+    double t = fm->anim->time + k / fm->anim->fps;
+    cli_progress_init(&fm->prog, fm->verbose);
+    zt_status st;
+    if (!fm->keep) {
+        st = zt_motions_apply(fm->motions, fm->scene0, t, fm->opt.seed, fm->scene, err);
+        if (st == ZT_OK)
+            st = zt_render(fm->scene, &fm->opt, img, stats, err);
+    } else {
+        zt_camera cam;
+        double built = 0;
+        st = zt_motions_camera(fm->motions, fm->scene0, t, &cam, err);
+        if (st == ZT_OK && !fm->r) {
+            double t0 = cli_now();
+            zt_scene_set_camera(fm->scene, &cam);
+            st = zt_renderer_create(fm->scene, &fm->opt, &fm->r, err);
+            built = fm->build_seconds = cli_now() - t0;
+        } else if (st == ZT_OK) {
+            st = zt_renderer_set_camera(fm->r, &cam, err);
+        }
+        if (st == ZT_OK)
+            st = zt_renderer_render(fm->r, img, stats, err);
+        stats->seconds += built;
+    }
+    cli_progress_finish(&fm->prog);
     return st;
 }
 
@@ -134,6 +167,12 @@ int cli_animate(const char *scene_path, const zt_render_options *options,
         st = zt_motions_load_file(anim->motions, &motions, &err);
     if (code == EXIT_OK && st == ZT_OK)
         st = zt_motions_check(motions, scene0, &err);
+    /* A camera path that degenerates between keys is found before any work. */
+    int has_path = code == EXIT_OK && st == ZT_OK && zt_motions_camera_path(motions, NULL);
+    for (int k = 0; has_path && st == ZT_OK && k < anim->frames; k++) {
+        zt_camera cam;
+        st = zt_motions_camera(motions, scene0, anim->time + k / anim->fps, &cam, &err);
+    }
     if (code == EXIT_OK && st == ZT_OK && !(scene = zt_scene_clone(scene0))) {
         st = ZT_ERR_MEMORY;
         snprintf(err.message, sizeof err.message, "out of memory");
@@ -152,8 +191,21 @@ int cli_animate(const char *scene_path, const zt_render_options *options,
      * lets the frames under way finish (a frame cut short would not match
      * its neighbours) and starts no other round.  Each frame is rendered
      * whole by one process, so it is the frame one process alone makes. */
-    zt_render_options opt = *options;
-    opt.stop = NULL;
+    frame_maker fm = {scene0, scene, motions, anim, *options, {0}, verbose,
+                      !zt_motions_moves_objects(motions), NULL, 0};
+    fm.opt.stop = NULL;
+    fm.opt.progress = cli_progress_callback;
+    fm.opt.progress_user = &fm.prog;
+    const zt_render_options *opt = &fm.opt;
+    if (verbose && cluster_rank() == 0) {
+        int keys = 0;
+        char path[64] = "no camera path";
+        if (zt_motions_camera_path(motions, &keys))
+            snprintf(path, sizeof path, "a camera path of %d keys", keys);
+        fprintf(stderr, "motions: %d of lights and things, %s: %s\n", zt_motions_count(motions),
+                path, fm.keep ? "the scene stands still, one renderer for every frame"
+                              : "the scene is prepared again for every frame");
+    }
     cli_interrupts_install("\nzonetrace: finishing the current frame, then stopping "
                            "(interrupt again to abort it)\n");
     const int ranks = cluster_ranks(), rank = cluster_rank();
@@ -185,9 +237,7 @@ int cli_animate(const char *scene_path, const zt_render_options *options,
         zt_image *img = NULL;
         zt_render_stats stats;
         memset(&stats, 0, sizeof stats);
-        st = k < anim->frames ? render_frame(scene0, motions, scene, &opt, anim, k, verbose,
-                                             &img, &stats, &err)
-                              : ZT_OK;
+        st = k < anim->frames ? render_frame(&fm, k, &img, &stats, &err) : ZT_OK;
         if (st != ZT_OK) {
             if (ranks == 1 && !quiet && !verbose)
                 fputc('\n', stderr);
@@ -245,19 +295,29 @@ int cli_animate(const char *scene_path, const zt_render_options *options,
             frames_done++;
             if ((!quiet && !verbose) || (ranks > 1 && verbose))
                 fprintf(stderr, ", %.2f s\n", stats.seconds);
-            cli_report_stop(&opt, &stats, quiet);
+            cli_report_stop(opt, &stats, quiet);
         }
         zt_image_release(img);
         code = cluster_agree(code);
     }
     free(mine);
     free(all);
-    if (!quiet && frames_done)
-        fprintf(stderr, "rendered %d frame%s in %.3f s%s: %llu rays, %.2f Mrays/s\n",
+    if (!quiet && frames_done) {
+        const char *what = opt->method == ZT_METHOD_ZONE ? "forest built" : "scene prepared";
+        char how[160];
+        if (fm.keep)
+            snprintf(how, sizeof how, "%s once%s for %d frame%s (%.3f s%s)", what,
+                     ranks > 1 ? " per process" : "", frames_done, frames_done == 1 ? "" : "s",
+                     fm.build_seconds, ranks > 1 ? " on process 0" : "");
+        else
+            snprintf(how, sizeof how, "%s for every frame (lights or things move)", what);
+        fprintf(stderr, "rendered %d frame%s in %.3f s%s: %llu rays, %.2f Mrays/s; %s\n",
                 frames_done, frames_done == 1 ? "" : "s", total_seconds,
                 ranks > 1 ? " of rendering over the processes" : "",
                 (unsigned long long)total_rays,
-                total_seconds > 0 ? total_rays / total_seconds / 1e6 : 0.0);
+                total_seconds > 0 ? total_rays / total_seconds / 1e6 : 0.0, how);
+    }
+    zt_renderer_release(fm.r);
 done:
     zt_scene_release(scene);
     zt_scene_release(scene0);

@@ -29,8 +29,8 @@ static void view_usage(FILE *f)
 "through it (docs/viewer.md).\n"
 "\n"
 "      --method M        path (default) or zone\n"
-"      --motions FILE    move lights and things as FILE says (the originals'\n"
-"                        motions file)\n"
+"      --motions FILE    move lights and things, and the camera along a path,\n"
+"                        as FILE says (the originals' motions file)\n"
 "      --fps N           frames per second to aim for (default 10)\n"
 "      --hud             show the HUD at start (u or Tab toggles it)\n"
 "      --size WxH        pixel grid (default: the scene's gridresolution)\n"
@@ -79,6 +79,7 @@ typedef struct viewer {
     /* state */
     zt_scene *scene0;
     zt_motions *motions;
+    int path_failed;        /* the camera path degenerated: no longer followed */
     zt_camera cam, cam_home;
     int light_count;
     int width, height;
@@ -139,13 +140,21 @@ static void show_message(viewer *v, const char *msg)
 
 /* ---- requests to the worker ---- */
 
-static void push_camera(viewer *v)
+/* Sends v->cam, the camera path's at motion time t (or t < 0: moved by a
+ * key or the mouse). */
+static void push_camera_at(viewer *v, double t)
 {
     pthread_mutex_lock(&v->sh.lock);
     v->sh.req.camera = v->cam;
+    v->sh.req.camera_time = t;
     atomic_fetch_add(&v->sh.cam_epoch, 1);
     pthread_cond_signal(&v->sh.wake);
     pthread_mutex_unlock(&v->sh.lock);
+}
+
+static void push_camera(viewer *v)
+{
+    push_camera_at(v, -1);
 }
 
 /* Changes the options under the lock; fn edits the request. */
@@ -266,6 +275,33 @@ static int held_catch_up(viewer *v, held_key *h, double t)
 }
 
 static void take_screenshot(viewer *v, const char *path);
+
+/* With a camera path, the camera follows it while the motions play: every
+ * frame tick sets the path's camera at the motion time, over any key or
+ * mouse move.  While they are paused the keys and the mouse move it from
+ * where the path left it. */
+static void follow_path(viewer *v, double now)
+{
+    if (v->path_failed || !zt_motions_camera_path(v->motions, NULL))
+        return;
+    pthread_mutex_lock(&v->sh.lock);
+    int paused = v->sh.req.motions_paused;
+    double t = view_motion_time(&v->sh.req, now);
+    pthread_mutex_unlock(&v->sh.lock);
+    if (paused)
+        return;
+    zt_camera cam;
+    zt_error err;
+    if (zt_motions_camera(v->motions, v->scene0, t, &cam, &err) != ZT_OK) {
+        v->path_failed = 1; /* said once; the camera stays where it was */
+        show_message(v, err.message);
+        return;
+    }
+    if (memcmp(&cam, &v->cam, sizeof cam) == 0)
+        return; /* holding still after the last key: the picture converges */
+    v->cam = cam;
+    push_camera_at(v, t);
+}
 
 static void reset_camera(viewer *v)
 {
@@ -908,10 +944,14 @@ static int load_inputs(viewer *v, view_args *a)
         st = zt_motions_load_file(a->motions_path, &v->motions, &err);
         if (st == ZT_OK)
             st = zt_motions_check(v->motions, v->scene0, &err);
+        /* the path's camera at time 0 from the first picture on */
+        if (st == ZT_OK && zt_motions_camera_path(v->motions, NULL))
+            st = zt_motions_camera(v->motions, v->scene0, 0.0, &v->cam, &err);
         if (st != ZT_OK) {
             fprintf(stderr, "zonetrace: %s\n", err.message);
             return cli_exit_code(st);
         }
+        v->cam_home = v->cam;
     }
     if (a->replay_path) {
         size_t len = 0;
@@ -1004,6 +1044,7 @@ static void main_loop(viewer *v)
                 next = now + period;
         }
         update_held(v, now);
+        follow_path(v, now);
         /* A new frame is shown at once; otherwise the window is redrawn
          * only for the HUD's figures and after keys, so a high --fps does
          * not spend the time on redrawing the same picture. */
@@ -1089,6 +1130,7 @@ int cli_view(int argc, char **argv)
         r->lights_off_count = a.lights_off_count;
         v->start = view_now();
         r->motion_origin = v->start;
+        r->camera_time = zt_motions_camera_path(v->motions, NULL) ? 0.0 : -1.0;
         v->shown.method = a.method;
         v->worker.shared = &v->sh;
         v->worker.cfg.scene0 = v->scene0;

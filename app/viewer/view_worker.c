@@ -107,7 +107,7 @@ static int ilog2(int x)
 
 static int has_motions(const wstate *s)
 {
-    return s->w->cfg.motions && zt_motions_count(s->w->cfg.motions) > 0;
+    return s->w->cfg.motions && zt_motions_moves_objects(s->w->cfg.motions);
 }
 
 /* Whether the scene must move to a new motion time. */
@@ -341,9 +341,14 @@ static void *worker_main(void *arg)
             zt_error err;
             s.cam_epoch = cam_epoch;
             s.req.camera = req.camera;
+            s.req.camera_time = req.camera_time;
             st = zt_renderer_set_camera(s.r, &req.camera, &err);
             s.zone_preview = s.method == ZT_METHOD_ZONE;
         }
+        /* A camera path's picture is of its camera's time when no object
+         * moves (else of the objects' time, within a frame of it). */
+        if (!has_motions(&s) && s.req.camera_time >= 0)
+            s.motion_time = s.req.camera_time;
         if (opt_changed || moved || cam_changed || st != ZT_OK) {
             s.spp = 0;
             s.ev_spp = 0;

@@ -99,6 +99,8 @@ typedef struct view_request {
     int motions_paused;
     double motion_time_paused; /* the motion time while paused */
     double motion_origin;    /* wall time at which the motion time was 0 */
+    double camera_time;      /* the motion time of a camera path's camera,
+                                or < 0 (the camera is the keys' or mouse's) */
 } view_request;
 
 typedef struct view_frame {

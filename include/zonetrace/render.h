@@ -83,12 +83,15 @@ typedef struct zt_render_options {
      * naming the file and the reason.  Format: docs/zone-tracer.md. */
     const char *forest_file;
 
-    /* Long renders (docs/long-renders.md); zt_render only. */
+    /* Long renders (docs/long-renders.md): zt_render and zt_renderer_render
+     * (zt_renderer_accumulate takes no notice of them). */
     /* Seconds the whole zt_render may take (0: no limit).  Path tracer:
      * whole passes of samples while the next one fits, at least one sample
      * per pixel; spp is then an upper bound.  Zone tracer: Phase One builds
      * the levels that fit and the image has the depth reached (not with
-     * level >= 0).  stats say what was reached. */
+     * level >= 0).  stats say what was reached.  A persistent renderer
+     * counts it from zt_renderer_create for its Phase One and from each
+     * zt_renderer_render for the path tracer's passes. */
     double time_limit;
     /* When not NULL and it becomes non-zero (a signal handler's flag): the
      * path tracer finishes its pass and returns the image of the samples
@@ -176,7 +179,8 @@ zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
 typedef struct zt_renderer zt_renderer;
 
 /* Prepares scene (copied: later changes to it do not affect the renderer)
- * for rendering with options.  *out is the caller's. */
+ * for rendering with options.  *out is the caller's.  The options are kept
+ * (their progress and stop pointers too) for the renderer's life. */
 zt_status zt_renderer_create(const zt_scene *scene,
                              const zt_render_options *options,
                              zt_renderer **out, zt_error *err);
@@ -193,6 +197,17 @@ zt_status zt_renderer_set_camera(zt_renderer *renderer, const zt_camera *camera,
 zt_status zt_renderer_accumulate(zt_renderer *renderer, int first_sample,
                                  int count, zt_image *sum,
                                  zt_render_stats *stats, zt_error *err);
+
+/* Renders the renderer's camera into a new linear image (*out, the
+ * caller's) as zt_render does: the image is the same, bit for bit, as
+ * zt_render of the scene with this camera and these options (path tracer:
+ * options.spp samples in double-precision sums, in passes that honour the
+ * time limit, stop and checkpoint; zone tracer: Phase Two over the
+ * renderer's forest).  With options.share every process calls it.  stats
+ * (may be NULL) are this image's; the zone tracer charges Phase One to a
+ * renderer's first image. */
+zt_status zt_renderer_render(zt_renderer *renderer, zt_image **out,
+                             zt_render_stats *stats, zt_error *err);
 
 void zt_renderer_release(zt_renderer *renderer);
 

@@ -121,6 +121,7 @@ static zt_status renderer_create(const zt_scene *scene, const zt_render_options 
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     }
     r->options = *o;
+    r->depth_asked = o->depth;
     r->memory_estimate = need;
     r->deadline = deadline;
     st = rscene_build(&r->rs, r->scene, o->lights_off, o->lights_off_count,
@@ -136,10 +137,15 @@ static zt_status renderer_create(const zt_scene *scene, const zt_render_options 
     return ZT_OK;
 }
 
+static double deadline_from(const zt_render_options *o, double t0)
+{
+    return o->time_limit > 0 ? t0 + o->time_limit : INFINITY;
+}
+
 zt_status zt_renderer_create(const zt_scene *scene, const zt_render_options *o,
                              zt_renderer **out, zt_error *err)
 {
-    return renderer_create(scene, o, INFINITY, out, NULL, err);
+    return renderer_create(scene, o, deadline_from(o, render_clock()), out, NULL, err);
 }
 
 zt_status zt_renderer_set_camera(zt_renderer *r, const zt_camera *camera,
@@ -173,6 +179,46 @@ zt_status zt_renderer_accumulate(zt_renderer *r, int first, int count, zt_image 
     return st;
 }
 
+/* One image of the renderer's camera; t0 is when its time limit started. */
+static zt_status renderer_render(zt_renderer *r, double t0, zt_image **out,
+                                 zt_render_stats *stats, zt_error *err)
+{
+    const zt_render_options *o = &r->options; /* the zone tracer's depth may be lower */
+    const zt_camera *c = &r->scene->camera;
+    stats->depth_done = o->level >= 0 ? o->level : o->depth;
+    if (o->method == ZT_METHOD_PATH)
+        return path_render_passes(r, t0, out, stats, err);
+    zt_image *img = zt_image_create(c->width, c->height);
+    if (!img)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for a %dx%d image", c->width,
+                       c->height);
+    zt_status st = zt_renderer_accumulate(r, 0, 1, img, stats, err);
+    if (st != ZT_OK) {
+        zt_image_release(img);
+        return st;
+    }
+    if (o->depth < r->depth_asked)
+        stats->stopped = (zt_stop_reason)zone_stop_reason(r);
+    *out = img;
+    return ZT_OK;
+}
+
+zt_status zt_renderer_render(zt_renderer *r, zt_image **out, zt_render_stats *stats,
+                             zt_error *err)
+{
+    zt_render_stats local;
+    if (!stats)
+        stats = &local;
+    memset(stats, 0, sizeof *stats);
+    *out = NULL;
+    double t0 = render_clock();
+    zt_status st = renderer_render(r, t0, out, stats, err);
+    stats->seconds = stats->trace_seconds = render_clock() - t0;
+    if (!stats->memory_estimate) /* the zone tracer's includes its forest */
+        stats->memory_estimate = r->memory_estimate;
+    return st;
+}
+
 zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
                     zt_image **out, zt_render_stats *stats, zt_error *err)
 {
@@ -183,29 +229,15 @@ zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
     *out = NULL;
     double t0 = render_clock();
     zt_renderer *r;
-    double deadline = options->time_limit > 0 ? t0 + options->time_limit : INFINITY;
-    zt_status st = renderer_create(scene, options, deadline, &r, stats, err);
+    zt_status st = renderer_create(scene, options, deadline_from(options, t0), &r, stats, err);
     if (st != ZT_OK)
         return st;
-    const zt_render_options *o = &r->options; /* the zone tracer's depth may be lower */
-    stats->depth_done = o->level >= 0 ? o->level : o->depth;
     double prepared = render_clock();
     zt_image *img = NULL;
-    if (o->method == ZT_METHOD_PATH) {
-        st = path_render_passes(r, t0, &img, stats, err);
-    } else {
-        img = zt_image_create(scene->camera.width, scene->camera.height);
-        st = img ? zt_renderer_accumulate(r, 0, 1, img, stats, err)
-                 : zt_fail(err, ZT_ERR_MEMORY, "out of memory for a %dx%d image",
-                           scene->camera.width, scene->camera.height);
-        if (o->depth < options->depth)
-            stats->stopped = (zt_stop_reason)zone_stop_reason(r);
-    }
+    st = renderer_render(r, t0, &img, stats, err);
     zt_renderer_release(r);
-    if (st != ZT_OK) {
-        zt_image_release(img);
+    if (st != ZT_OK)
         return st;
-    }
     stats->seconds = render_clock() - t0;
     stats->trace_seconds = render_clock() - prepared;
     *out = img;

@@ -42,8 +42,10 @@ struct zt_renderer {
     zt_render_options options;
     rscene rs;
     struct zone_forest *forest; /* zone tracer only */
-    double deadline;            /* render_clock() time to be done by
-                                   (INFINITY: no time limit) */
+    double deadline;            /* render_clock() time for Phase One to be
+                                   done by (INFINITY: no time limit) */
+    int depth_asked;            /* options.depth as given (the zone tracer
+                                   lowers options.depth to what it built) */
     uint64_t memory_estimate;   /* bytes: image, scene copy, acceleration
                                    (render/memory.h); the zone tracer adds
                                    its forest's */

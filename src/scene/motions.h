@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "zonetrace/motion.h"
+#include "scene/camera_path.h"
 
 /* Brownian motions are random walks of fixed 10 ms steps: evaluating one at
  * time t sums t/10ms steps.  The last sum is kept so that a viewer or an
@@ -24,6 +25,7 @@ struct zt_motions {
     int count;
     motion_walk *walks;  /* one per motion (used by brownian ones) */
     pthread_mutex_t lock; /* guards walks */
+    camera_path path;    /* count 0: no camera path */
 };
 
 /* The length of one brownian step in seconds. */

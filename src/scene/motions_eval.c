@@ -7,7 +7,8 @@
  *                n = floor(t / 10 ms), f its fraction, d_i seeded unit
  *                directions uniform on the sphere
  *
- * applied in file order, each to the result of those before it. */
+ * applied in file order, each to the result of those before it.  The
+ * camera path is camera_path.c's. */
 #include "zonetrace/motion.h"
 
 #include <math.h>
@@ -126,6 +127,54 @@ static zt_status apply_one(zt_motions *ms, int index, uint64_t seed, double t,
     return zt_scene_translate_object(s, m->target_class, m->target, d, err);
 }
 
+static zt_status check_time(double t, zt_error *err)
+{
+    if (!(t >= 0) || !isfinite(t))
+        return zt_fail(err, ZT_ERR_ARGUMENT, "motion time must be a number >= 0, not %g", t);
+    return ZT_OK;
+}
+
+/* The camera path's camera at t on the grid of scene0's camera. */
+static zt_status path_camera(const zt_motions *ms, const zt_scene *scene0, double t,
+                             zt_camera *out, zt_error *err)
+{
+    zt_camera cam = scene0->camera;
+    if (!scene0->has_camera || cam.width < 1 || cam.height < 1)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "the camera path needs the scene's pixel grid, "
+                       "and the scene has no camera");
+    double pos[3], at[3], up[3], fov;
+    camera_path_at(&ms->path, t, pos, at, up, &fov);
+    zt_error why;
+    zt_error_clear(&why);
+    if (zt_camera_look_at(&cam, pos, at, up, fov, cam.width, cam.height, &why) == ZT_OK) {
+        *out = cam;
+        return ZT_OK;
+    }
+    /* The keys themselves were checked: t lies between two of them, and the
+     * file is at fault. */
+    int i = camera_path_segment(&ms->path, t);
+    const zt_camera_key *k = &ms->path.keys[i < 0 ? 0 : i];
+    return zt_fail(err, ZT_ERR_PARSE, "%s:%d:%d: the camera path between this key and the "
+                   "next is degenerate at %g s: %s", ms->name, k->line, k->column, t,
+                   why.message);
+}
+
+zt_status zt_motions_camera(const zt_motions *motions, const zt_scene *scene0, double t,
+                            zt_camera *out, zt_error *err)
+{
+    zt_error_clear(err);
+    if (!motions || !scene0 || !out)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "zt_motions_camera: no motions, scene or camera");
+    zt_status st = check_time(t, err);
+    if (st != ZT_OK)
+        return st;
+    if (!motions->path.count) {
+        *out = scene0->camera;
+        return ZT_OK;
+    }
+    return path_camera(motions, scene0, t, out, err);
+}
+
 zt_status zt_motions_apply(const zt_motions *motions,
                            const zt_scene *scene0, double t, uint64_t seed,
                            zt_scene *out, zt_error *err)
@@ -133,8 +182,9 @@ zt_status zt_motions_apply(const zt_motions *motions,
     zt_error_clear(err);
     if (!motions || !scene0 || !out)
         return zt_fail(err, ZT_ERR_ARGUMENT, "zt_motions_apply: no motions or no scene");
-    if (!(t >= 0) || !isfinite(t))
-        return zt_fail(err, ZT_ERR_ARGUMENT, "motion time must be a number >= 0, not %g", t);
+    zt_status st = check_time(t, err);
+    if (st != ZT_OK)
+        return st;
     if (out->object_count != scene0->object_count || out->part_count != scene0->part_count)
         return zt_fail(err, ZT_ERR_ARGUMENT, "zt_motions_apply: the output scene is "
                        "not a clone of the scene at time 0");
@@ -152,9 +202,16 @@ zt_status zt_motions_apply(const zt_motions *motions,
     /* The cache of the walks is the only state that changes. */
     zt_motions *ms = (zt_motions *)motions;
     for (int i = 0; i < ms->count; i++) {
-        zt_status st = apply_one(ms, i, seed, t, out, err);
+        st = apply_one(ms, i, seed, t, out, err);
         if (st != ZT_OK)
             return st;
+    }
+    if (ms->path.count) {
+        zt_camera cam;
+        st = path_camera(ms, scene0, t, &cam, err);
+        if (st != ZT_OK)
+            return st;
+        zt_scene_set_camera(out, &cam);
     }
     return ZT_OK;
 }

@@ -1,6 +1,7 @@
 /* Loading a motions file: reading it, jansson, the position index (the
  * same machinery as scene files, so messages are "file:line:column: ..."),
- * and the checks of each motion.  Also zt_motions_check. */
+ * and the checks of each motion and of the camera path.  Also
+ * zt_motions_check and the queries of a list. */
 #define _POSIX_C_SOURCE 200809L
 #include "zonetrace/motion.h"
 
@@ -199,6 +200,118 @@ static zt_status load_motion(load_ctx *ctx, jref mref, zt_motion *m)
     return ZT_OK;
 }
 
+/* Line and column of an array's element, for the keys of a camera path. */
+static void element_place(const load_ctx *ctx, const json_t *array, size_t i, int *line,
+                          int *column)
+{
+    size_t parsed = json_positions_element(ctx->positions, array, i);
+    size_t original = source_map_original(ctx->map, parsed);
+    if (!source_map_locate(ctx->map, original, line, column))
+        *line = *column = 0;
+}
+
+static zt_status load_camera_key(load_ctx *ctx, jref kref, const zt_camera_key *prev,
+                                 zt_camera_key *k)
+{
+    static const char *const keys[] = {"time", "position", "lookat", "up", "fov", NULL};
+    const json_t *obj = kref.value;
+    if (!json_is_object(obj))
+        return load_fail(ctx, kref, "wrong type: a camera key must be an object, not %s",
+                         load_type_name(obj));
+    if (load_known_keys(ctx, kref, "a camera key", keys) ||
+        load_require(ctx, kref, "time", "a camera key") ||
+        load_require(ctx, kref, "position", "a camera key") ||
+        load_require(ctx, kref, "lookat", "a camera key"))
+        return ZT_ERR_PARSE;
+    jref time = jref_member(obj, "time"), lookat = jref_member(obj, "lookat");
+    jref up_ref = jref_member(obj, "up"), fov_ref = jref_member(obj, "fov");
+    vec3 pos, at, up = v3(0, 1, 0);
+    double fov = 40; /* the defaults of a scene file's aimed camera */
+    if (load_number(ctx, time, &k->time) ||
+        load_triple(ctx, jref_member(obj, "position"), &pos) ||
+        load_triple(ctx, lookat, &at) ||
+        (up_ref.value && load_triple(ctx, up_ref, &up)) ||
+        (fov_ref.value && load_number(ctx, fov_ref, &fov)))
+        return ZT_ERR_PARSE;
+    if (prev && !(k->time > prev->time))
+        return load_fail(ctx, time, "time %g is not after the previous key's (%g): the keys "
+                         "of a camera path go in strictly increasing time", k->time,
+                         prev->time);
+    if (!(fov > 0 && fov < 180))
+        return load_fail(ctx, fov_ref, "fov out of range: %g (the vertical field of view, "
+                         "in degrees, between 0 and 180)", fov);
+    if (pos.x == at.x && pos.y == at.y && pos.z == at.z)
+        return load_fail(ctx, lookat, "lookat equals position: the camera must look "
+                         "somewhere else");
+    if (up.x == 0 && up.y == 0 && up.z == 0)
+        return load_fail(ctx, up_ref, "up must not be zero");
+    v3_store(pos, k->position);
+    v3_store(at, k->lookat);
+    v3_store(up, k->up);
+    k->fov = fov;
+    zt_camera cam;
+    zt_error cerr;
+    zt_error_clear(&cerr);
+    /* What is left to fail: up parallel to the view. */
+    if (zt_camera_look_at(&cam, k->position, k->lookat, k->up, fov, 1, 1, &cerr) != ZT_OK) {
+        if (up_ref.value)
+            return load_fail(ctx, up_ref, "up is parallel to the view direction (from "
+                             "position to lookat)");
+        return load_fail(ctx, kref, "the default up (0, 1, 0) is parallel to the view "
+                         "direction (from position to lookat): give \"up\"");
+    }
+    return ZT_OK;
+}
+
+/* {"camera": "path", "keys": [...]}: the camera path, at most one. */
+static zt_status load_camera_path(load_ctx *ctx, jref cref, zt_motions *ms)
+{
+    static const char *const keys[] = {"camera", "keys", NULL};
+    const json_t *obj = cref.value;
+    if (load_known_keys(ctx, cref, "a camera path", keys))
+        return ZT_ERR_PARSE;
+    jref kind = jref_member(obj, "camera");
+    if (!json_is_string(kind.value))
+        return load_fail(ctx, kind, "wrong type: \"camera\" must be \"path\", not %s",
+                         load_type_name(kind.value));
+    if (strcmp(json_string_value(kind.value), "path") != 0)
+        return load_fail(ctx, kind, "unknown camera motion \"%.64s\": expected \"path\"",
+                         json_string_value(kind.value));
+    if (ms->path.count)
+        return load_fail_key(ctx, obj, "camera", "a second camera path: a motions file has "
+                             "at most one (the first has its first key on line %d)",
+                             ms->path.keys[0].line);
+    if (load_require(ctx, cref, "keys", "a camera path"))
+        return ZT_ERR_PARSE;
+    jref list = jref_member(obj, "keys");
+    if (!json_is_array(list.value))
+        return load_fail(ctx, list, "wrong type: \"keys\" must be a list of camera keys, "
+                         "not %s", load_type_name(list.value));
+    size_t n = json_array_size(list.value);
+    if (n < 2)
+        return load_fail(ctx, list, "a camera path needs at least two keys, found %zu", n);
+    if (n > 100000)
+        return load_fail(ctx, list, "too many camera keys (%zu; the limit is 100000)", n);
+    camera_path path = {calloc(n, sizeof(zt_camera_key)), 0, NULL, NULL};
+    if (!path.keys)
+        return load_fail_offset(ctx, ZT_ERR_MEMORY, SOURCE_OFFSET_UNKNOWN, "out of memory");
+    for (size_t i = 0; i < n; i++) {
+        zt_camera_key *k = &path.keys[i];
+        if (load_camera_key(ctx, jref_element(list.value, i), i ? k - 1 : NULL, k)) {
+            camera_path_free(&path);
+            return ZT_ERR_PARSE;
+        }
+        element_place(ctx, list.value, i, &k->line, &k->column);
+        path.count++;
+    }
+    if (!camera_path_prepare(&path)) {
+        camera_path_free(&path);
+        return load_fail_offset(ctx, ZT_ERR_MEMORY, SOURCE_OFFSET_UNKNOWN, "out of memory");
+    }
+    ms->path = path;
+    return ZT_OK;
+}
+
 static zt_status load_top(load_ctx *ctx, const json_t *root, zt_motions *ms)
 {
     static const char *const keys[] = {"motions", NULL};
@@ -225,7 +338,14 @@ static zt_status load_top(load_ctx *ctx, const json_t *root, zt_motions *ms)
                                     "out of memory");
     }
     for (size_t i = 0; i < n; i++) {
-        zt_status s = load_motion(ctx, jref_element(list.value, i), &ms->items[i]);
+        jref m = jref_element(list.value, i);
+        if (json_is_object(m.value) && json_object_get(m.value, "camera")) {
+            zt_status s = load_camera_path(ctx, m, ms);
+            if (s)
+                return s;
+            continue;
+        }
+        zt_status s = load_motion(ctx, m, &ms->items[ms->count]);
         if (s)
             return s;
         ms->count++;
@@ -253,6 +373,7 @@ void zt_motions_release(zt_motions *ms)
     if (!ms)
         return;
     pthread_mutex_destroy(&ms->lock);
+    camera_path_free(&ms->path);
     free(ms->items);
     free(ms->walks);
     free(ms->name);
@@ -355,6 +476,19 @@ const zt_motion *zt_motions_get(const zt_motions *ms, int i)
     if (!ms || i < 0 || i >= ms->count)
         return NULL;
     return &ms->items[i];
+}
+
+int zt_motions_moves_objects(const zt_motions *ms)
+{
+    return ms && ms->count > 0;
+}
+
+const zt_camera_key *zt_motions_camera_path(const zt_motions *ms, int *count)
+{
+    int n = ms ? ms->path.count : 0;
+    if (count)
+        *count = n;
+    return n ? ms->path.keys : NULL;
 }
 
 zt_status zt_motions_check(const zt_motions *ms, const zt_scene *scene,
