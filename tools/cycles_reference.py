@@ -1,37 +1,94 @@
 """Renders a zonetrace scene with Blender's Cycles, as an independent reference.
 
     blender -b -P tools/cycles_reference.py -- SCENE.json OUT.pfm --spp N [--seed S]
-            [--bounces B] [--plane-size H] [--threads T]
+            [--size WxH] [--bounces B] [--plane-size H] [--light-offset D]
+            [--sphere-subdivisions K] [--light-subdivisions K] [--scale U] [--ggx multi|single]
+            [--threads T]
 
 Writes OUT as linear float RGB (PFM, bottom row first, as zonetrace writes it; an OUT ending in
 .exr is written as OpenEXR instead).  Needs Blender 3.4 (scripts/install-reference-tools.sh).
 
 Supported, and nothing else (anything else stops the script with a message naming it):
   top level   "camera", "scene"
-  camera      the aimed form only: "position", "lookat", "up" ([0, 1, 0]), "fov" (40, vertical,
-              degrees), "gridresolution" ([512, 512]); a pinhole with square pixels
-  items       "plane" {"normal", "offset"}: a square of half-size --plane-size (10000) centred
-                on the point of the plane nearest the camera's look-at point
-              "sphere" {"center", "radius"}: an exact sphere (a Cycles point-cloud point)
+  camera      the four-corner form: "viewpoint", "screen" (TL, TR, BL, BR; BR unused, as in
+                zonetrace), "gridresolution": a pinhole exactly through the viewpoint and the
+                screen's corners, the screen being the near plane.  The screen must be a
+                rectangle, seen from the side that does not mirror the image; non-square pixels
+                become Blender's pixel aspect, a screen centre off the eye's axis a lens shift
+              the aimed form: "position", "lookat", "up" ([0, 1, 0]), "fov" (40, vertical,
+                degrees), "gridresolution" ([512, 512]), made into four corners as zonetrace does
+                (the screen a thousandth of the distance to "lookat" in front of the eye)
+              --size WxH replaces the grid and keeps the screen, as zonetrace's --size
+  things      "plane" {"normal", "offset"}: a square of half-size --plane-size (10000) centred
+                on the point of the plane nearest the view's centre (the look-at point, or the
+                screen's centre)
+              "sphere" {"center", "radius"}: an exact sphere (a Cycles point-cloud point) when
+                backculled, or when opaque (no refractive weight) with the camera outside it:
+                Cycles never shows a point from inside.  Otherwise (glass; a camera inside) a
+                geodesic sphere of 20 x 4^K flat triangles (K = --sphere-subdivisions, 6) with
+                the radial direction as smooth shading normal
               "triangle" {"points"}: flat-shaded
-              "thing" {"parts", "material"}: parts are those three primitives and one-key
-                {"material": ...} entries; as in zonetrace the last material given wins
-              each primitive and thing may carry "material", and "background" / "backculled"
-                only when false (Cycles has neither rule)
-              "sun" {"direction", "irradiance", "angle" (0.53)}: a sun lamp whose strength is the
+              "thing" {"parts", "material", "background", "backculled"}: a group of those; as in
+                zonetrace a setting may stand on the group, in a part's body or as a one-key
+                part, and the last one in the file wins
+  lights      "lighttriangle" {"points"}, "lightplane" {"normal", "offset"} (a square, as planes),
+                "lightsphere" {"center", "radius"} (always the geodesic sphere), alone or as parts
+                of a "light" group {"parts", "emission", "background", "backculled"}: an Emission
+                shader of radiance "emission" (W/m^2/sr per channel), the same seen by the camera;
+                Cycles samples them as mesh lights.  Lights reflect nothing and block light.
+                Cycles 3.4 samples a mesh light's triangle by solid angle, with approximate
+                arithmetic that loses light of triangles seen small or edge-on (2% on the
+                Cornell box's back wall), from points nearer its plane than a distance that
+                grows as the cube of the triangle's size, and by area, exactly, from farther.
+                So the scene is scaled by a power of 2 (--scale, default: light triangles at
+                most 1 unit long) and each light triangle is cut into 4^K equal pieces
+                (--light-subdivisions, default: the least K bringing that distance below
+                1/1000 of the triangle; the script prints it).  With --scale 1
+                --light-subdivisions 0 the light is sampled as Cycles does by itself
+  settings    "backculled": the back face is a Transparent BSDF, so rays cross it from behind and
+                a light emits from its front only.  Fronts as zonetrace's: a plane's normal side,
+                a triangle's counter-clockwise side ((p1 - p0) x (p2 - p0)), a sphere's outside
+              "background": planes only, and only where it changes nothing: every foreground
+                part and the camera must lie on the plane's front side (checked), so that the
+                nearest hit is zonetrace's.  A foreground triangle lying in a background plane
+                (the Cornell box's light in its ceiling; zonetrace gives the tie to the
+                foreground) is moved --light-offset (0.01) off it along the plane's normal
+  material    "character" {"diffuse", "metallic", "reflecting", "refractive"}, "color",
+                "refractiveindex" (1), "roughness" (0), "thin" (false only): the sum of the lobes
+                of zonetrace's docs/light-transport.md, each a Cycles BSDF whose colour is its
+                weight times "color":
+                diffuse     Diffuse BSDF, roughness 0 (Lambertian)
+                reflecting  Glossy BSDF (no Fresnel, like zonetrace's mirror lobe)
+                refractive  Glass BSDF of index "refractiveindex" (the exact dielectric Fresnel;
+                            reflection and transmission tinted by "color")
+                metallic    smooth only: a Sharp Glossy BSDF whose colour is further multiplied by
+                            Schlick's Fresnel, R0 = ((1 - n) / (1 + n))^2, at the shading normal
+                            (Layer Weight's Facing), which is zonetrace's smooth metal exactly
+              Roughness 0 gives Sharp lobes, above 0 Multiscatter GGX lobes with Cycles'
+                roughness = ours (alpha = roughness^2; zonetrace's floor of 0.01 is applied).
+                Both put back the light single scattering loses, but not in the same way:
+                Cycles follows its random walk among the microfacets (Heitz 2016), which
+                spreads that light into a wide tail, zonetrace scales the single-scattering
+                lobe (Turquin 2019), which keeps its shape.  A white rough mirror returns all
+                its light in both; at roughness 0.2 a white glass sphere in a white furnace
+                returns 0.999 in Cycles and 0.996 in zonetrace (0.98 near its outline).
+                --ggx single takes single-scattering GGX lobes instead (to compare with a
+                zonetrace built without compensation): the mirrors then agree exactly, the
+                glasses not quite (the furnace: Cycles 0.968, zonetrace 0.985)
+  far light   "sun" {"direction", "irradiance", "angle" (0.53)}: a sun lamp whose strength is the
                 irradiance on a surface facing it (W/m^2, per channel through the lamp colour)
               "sky" {"color"}: the world's background colour (radiance, W/m^2/sr)
               "sky" {"file", "strength" (1), "rotate" (0)}: an equirectangular environment
                 texture (OpenEXR, Radiance HDR, or PFM), nearest-texel lookup as zonetrace's
-  material    "character" {"diffuse": 1, the other three 0}, "color" (the albedo),
-              "refractiveindex" (ignored: it does not affect a diffuse surface); a Diffuse BSDF
-              with roughness 0 (Lambertian, as zonetrace's diffuse lobe)
-Not supported: lights of any kind, meshes, sky models, a sun by "place", the viewpoint/screen
-camera, the legacy non-JSON group syntax.
+Not supported: "lightpoint", a rough "metallic" lobe (zonetrace takes Schlick's Fresnel at each
+microfacet, which no Cycles 3.4 node can), "thin" panes, "background" on anything but planes or
+where a foreground part or the camera stands behind the plane, meshes, sky models, a sun by
+"place", a skewed or mirroring screen, the legacy non-JSON group syntax.
 
-Frames: zonetrace's +y is Blender's +Z, (x, y, z) -> (x, -z, y).  Render settings: Cycles on the
-CPU, box pixel filter 1 pixel wide, no denoising, no adaptive sampling, no clamping, Standard view
-transform, caustics on, every bounce limit --bounces (16; Cycles then scatters up to 17 times).
+Frames: zonetrace's +y is Blender's +Z, (x, y, z) -> (x, -z, y), times --scale.  Render
+settings: Cycles on the CPU, box pixel filter 1 pixel wide, no denoising, no adaptive sampling, no
+clamping, Standard view transform, caustics on, every bounce limit --bounces (16; Cycles then
+scatters up to 17 times).
 """
 import argparse
 import array
@@ -54,8 +111,18 @@ def fail(msg):
     raise SceneError(msg)
 
 
+UNIT = [1.0]  # Blender units per scene unit (--scale)
+GGX_KIND = ["MULTI_GGX"]  # the rough lobes' distribution (--ggx)
+
+
 def to_blender(p):
-    return Vector((p[0], -p[2], p[1]))
+    """A point: ours (x, y, z) is Blender's (x, -z, y), times the scale."""
+    u = UNIT[0]
+    return Vector((p[0] * u, -p[2] * u, p[1] * u))
+
+
+def to_blender_dir(d):
+    return Vector((d[0], -d[2], d[1]))
 
 
 def triple(v, what):
@@ -71,6 +138,12 @@ def number(v, what):
     return float(v)
 
 
+def boolean(v, what):
+    if not isinstance(v, bool):
+        fail("%s must be true or false, not %r" % (what, v))
+    return v
+
+
 def keys_ok(obj, allowed, what):
     if not isinstance(obj, dict):
         fail("%s must be an object" % what)
@@ -80,36 +153,307 @@ def keys_ok(obj, allowed, what):
                  % (what, k, ", ".join(sorted(allowed))))
 
 
+# ---------------------------------------------------------------- the scene's objects
+
+THING_PRIMS = {"plane": {"normal", "offset"}, "sphere": {"center", "radius"},
+               "triangle": {"points"}}
+LIGHT_PRIMS = {"lightplane": {"normal", "offset"}, "lightsphere": {"center", "radius"},
+               "lighttriangle": {"points"}}
+SETTINGS = {"thing": {"material", "background", "backculled"},
+            "light": {"emission", "background", "backculled"}}
+
+
+class Obj:
+    """One zonetrace object (a thing or a light) and its parts, geometry as given."""
+
+    def __init__(self, cls, where):
+        self.cls = cls  # "thing" or "light"
+        self.where = where
+        self.parts = []  # (primitive without "light", geometry dict)
+        self.material = None
+        self.emission = [0.0, 0.0, 0.0]
+        self.background = False
+        self.backculled = False
+
+    def setting(self, key, value):
+        what = "%s: %s" % (self.where, key)
+        if key == "material":
+            self.material = value  # checked when it is built
+        elif key == "emission":
+            self.emission = triple(value, what)
+            if min(self.emission) < 0:
+                fail("%s must not be negative" % what)
+        else:
+            setattr(self, key, boolean(value, what))
+
+
+def parse_part(obj, prim, body):
+    """A primitive's body: its geometry, and settings that apply to its object."""
+    cls_prims = THING_PRIMS if obj.cls == "thing" else LIGHT_PRIMS
+    if prim == "lightpoint":
+        fail("%s: lightpoint is not supported by this script" % obj.where)
+    if prim not in cls_prims:
+        fail("%s: part %r is not supported in a %s (supported: %s)"
+             % (obj.where, prim, obj.cls, ", ".join(sorted(cls_prims))))
+    geo_keys = cls_prims[prim]
+    keys_ok(body, geo_keys | SETTINGS[obj.cls], "%s: %s" % (obj.where, prim))
+    kind = prim[5:] if prim.startswith("light") else prim
+    geo = {}
+    for k in sorted(geo_keys):
+        if k not in body:
+            fail("%s: %s: missing %r" % (obj.where, prim, k))
+    for k, v in body.items():  # in the file's order
+        if k in geo_keys:
+            geo[k] = v
+        else:
+            obj.setting(k, v)
+    what = "%s: %s" % (obj.where, prim)
+    if kind == "plane":
+        n = Vector(triple(geo["normal"], what + " normal"))
+        if n.length == 0:
+            fail("%s normal is zero" % what)
+        d = number(geo["offset"], what + " offset") / n.length
+        geo = {"normal": n.normalized(), "offset": d}
+    elif kind == "sphere":
+        r = number(geo["radius"], what + " radius")
+        if r <= 0:
+            fail("%s radius must be positive" % what)
+        geo = {"center": Vector(triple(geo["center"], what + " center")), "radius": r}
+    else:
+        pts = geo["points"]
+        if not isinstance(pts, list) or len(pts) != 3:
+            fail("%s: points must be 3 triples" % what)
+        geo = {"points": [Vector(triple(p, what + " point")) for p in pts]}
+    obj.parts.append((kind, geo))
+
+
+def parse_item(kind, body, index):
+    where = "scene item %d (%s)" % (index, kind)
+    if kind in THING_PRIMS or kind in LIGHT_PRIMS or kind == "lightpoint":
+        obj = Obj("light" if kind.startswith("light") else "thing", where)
+        if not isinstance(body, dict):
+            fail("%s must be an object" % where)
+        parse_part(obj, kind, body)
+        return obj
+    obj = Obj(kind, where)  # a "thing" or "light" group
+    if not isinstance(body, dict):
+        fail("%s must be an object (the legacy non-JSON group syntax is not supported)" % where)
+    keys_ok(body, {"parts"} | SETTINGS[kind], where)
+    if "parts" not in body:
+        fail("%s: missing \"parts\"" % where)
+    for k, v in body.items():  # settings and parts in the file's order: the last one wins
+        if k != "parts":
+            obj.setting(k, v)
+            continue
+        if not isinstance(v, list) or not v:
+            fail("%s: parts must be a non-empty list" % where)
+        for part in v:
+            if not isinstance(part, dict) or len(part) != 1:
+                fail("%s: each part must be a one-key object" % where)
+            (pk, pv), = part.items()
+            if pk in SETTINGS[kind]:
+                obj.setting(pk, pv)
+            else:
+                if not isinstance(pv, dict):
+                    fail("%s: part %r must be an object" % (where, pk))
+                parse_part(obj, pk, pv)
+    return obj
+
+
+def tolerance(*values):
+    return 1e-6 * max([1.0] + [abs(float(x)) for v in values
+                               for x in (v if hasattr(v, "__len__") else [v])])
+
+
+def check_background(objs, cam_points, offset):
+    """Cycles has no background rule: it is kept only where the nearest hit gives the same.
+
+    A background plane whose front half-space (closed) holds the camera and every foreground
+    part is never seen through a foreground part nor hides one, and no ray reaches its back.
+    A foreground triangle lying in the plane would tie with it; zonetrace gives the tie to
+    the foreground, so the triangle is moved `offset` to the plane's front."""
+    planes = []
+    for o in objs:
+        if not o.background:
+            continue
+        for kind, g in o.parts:
+            if kind != "plane":
+                fail("%s: \"background\" is supported on planes only, not on a %s "
+                     "(Cycles has no background rule)" % (o.where, kind))
+            planes.append((o, g["normal"], g["offset"]))
+    for bo, n, d in planes:
+        def front(p, margin=0.0):
+            return n.dot(p) - margin >= d - tolerance(d, p)
+        for p in cam_points:
+            if not front(p):
+                fail("%s: background plane with the camera behind it (Cycles has no "
+                     "background rule)" % bo.where)
+        for o in objs:
+            if o.background:
+                continue
+            for i, (kind, g) in enumerate(o.parts):
+                if kind == "triangle":
+                    pts = g["points"]
+                    if offset > 0 and all(abs(n.dot(p) - d) <= tolerance(d, p) for p in pts):
+                        pts = [p + offset * n for p in pts]
+                        o.parts[i] = (kind, {"points": pts, "moved": True})
+                    ok = all(front(p) for p in pts)
+                elif kind == "sphere":
+                    ok = front(g["center"], g["radius"])
+                else:
+                    ok = abs(abs(n.dot(g["normal"])) - 1) < 1e-12 and g["offset"] * n.dot(
+                        g["normal"]) >= d - tolerance(d)
+                if not ok:
+                    fail("%s: a foreground %s stands behind the background plane of %s "
+                         "(Cycles has no background rule)" % (o.where, kind, bo.where))
+    return len(planes)
+
+
 # ---------------------------------------------------------------- materials
 
-def diffuse_material(m, cache):
-    keys_ok(m, {"character", "color", "refractiveindex"}, "material")
+def node_material(name):
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    return mat, nt
+
+
+def finish_material(mat, nt, shader_out, backculled):
+    """Connects the surface shader; a culled surface's back is transparent (rays cross it)."""
+    if backculled:
+        geo = nt.nodes.new("ShaderNodeNewGeometry")
+        clear = nt.nodes.new("ShaderNodeBsdfTransparent")
+        clear.inputs["Color"].default_value = (1, 1, 1, 1)
+        mix = nt.nodes.new("ShaderNodeMixShader")
+        nt.links.new(geo.outputs["Backfacing"], mix.inputs["Fac"])
+        nt.links.new(shader_out, mix.inputs[1])
+        nt.links.new(clear.outputs["BSDF"], mix.inputs[2])
+        shader_out = mix.outputs["Shader"]
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    out.target = "CYCLES"
+    nt.links.new(shader_out, out.inputs["Surface"])
+    return mat
+
+
+def lobe_weights(m, what):
     ch = m.get("character")
-    keys_ok(ch, {"diffuse", "metallic", "reflecting", "refractive"}, "character")
-    weights = {k: number(ch.get(k, 0), "character." + k) for k in
-               ("diffuse", "metallic", "reflecting", "refractive")}
-    if weights["diffuse"] != 1 or any(weights[k] != 0 for k in
-                                      ("metallic", "reflecting", "refractive")):
-        fail("material %r: only purely diffuse materials (diffuse 1, the rest 0) are "
-             "supported" % ch)
-    color = triple(m.get("color"), "material color")
-    key = tuple(color)
-    if key not in cache:
-        mat = bpy.data.materials.new("diffuse_%d" % len(cache))
-        mat.use_nodes = True
-        nt = mat.node_tree
-        nt.nodes.clear()
-        bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
-        bsdf.inputs["Color"].default_value = (*color, 1.0)
-        bsdf.inputs["Roughness"].default_value = 0.0
-        out = nt.nodes.new("ShaderNodeOutputMaterial")
-        nt.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-        cache[key] = mat
+    keys_ok(ch, {"diffuse", "metallic", "reflecting", "refractive"}, what + " character")
+    w = {}
+    for k in ("diffuse", "metallic", "reflecting", "refractive"):
+        if k not in ch:
+            fail("%s: character needs %r" % (what, k))
+        w[k] = number(ch[k], "%s character.%s" % (what, k))
+        if not 0 <= w[k] <= 1:
+            fail("%s: character.%s must be in [0, 1]" % (what, k))
+    if abs(sum(w.values()) - 1) > 1e-6:
+        fail("%s: the character's weights must add up to 1" % what)
+    return w
+
+
+def thing_material(m, backculled, cache, what):
+    """zonetrace's lobe mixture (docs/light-transport.md) as a sum of weighted Cycles BSDFs."""
+    key = (json.dumps(m, sort_keys=True), backculled)
+    if key in cache:
+        return cache[key]
+    keys_ok(m, {"character", "color", "refractiveindex", "roughness", "thin"}, what)
+    w = lobe_weights(m, what)
+    color = triple(m.get("color"), what + " color")
+    if not all(0 <= c <= 1 for c in color):
+        fail("%s: color must be in [0, 1]" % what)
+    ior = number(m.get("refractiveindex", 1), what + " refractiveindex")
+    if ior <= 0:
+        fail("%s: refractiveindex must be positive" % what)
+    rough = number(m.get("roughness", 0), what + " roughness")
+    if not 0 <= rough <= 1:
+        fail("%s: roughness must be in [0, 1]" % what)
+    if rough > 0:
+        rough = max(rough, 0.01)  # zonetrace's floor: alpha at least 1e-4
+    if boolean(m.get("thin", False), what + " thin") and w["refractive"] > 0:
+        fail("%s: thin panes are not supported by this script" % what)
+    if w["metallic"] > 0 and rough > 0:
+        fail("%s: a rough metallic lobe is not supported: zonetrace takes Schlick's Fresnel "
+             "at each microfacet normal, which Cycles 3.4's nodes cannot express" % what)
+    mat, nt = node_material("material_%d" % len(cache))
+
+    def tinted(weight):
+        return (*[weight * c for c in color], 1.0)
+
+    def distribution(node):
+        if rough > 0:
+            node.distribution = GGX_KIND[0]
+            node.inputs["Roughness"].default_value = rough
+        else:
+            node.distribution = "SHARP"
+            node.inputs["Roughness"].default_value = 0.0
+
+    lobes = []
+    if w["diffuse"] > 0:
+        n = nt.nodes.new("ShaderNodeBsdfDiffuse")
+        n.inputs["Color"].default_value = tinted(w["diffuse"])
+        n.inputs["Roughness"].default_value = 0.0  # Lambertian
+        lobes.append(n.outputs["BSDF"])
+    if w["metallic"] > 0:
+        # colour x Schlick(cos at the shading normal): Facing = 1 - |I.N| at blend 0.5.
+        r0 = ((1 - ior) / (1 + ior)) ** 2
+        lw = nt.nodes.new("ShaderNodeLayerWeight")
+        lw.inputs["Blend"].default_value = 0.5
+        p5 = nt.nodes.new("ShaderNodeMath")
+        p5.operation = "POWER"
+        p5.use_clamp = False
+        nt.links.new(lw.outputs["Facing"], p5.inputs[0])
+        p5.inputs[1].default_value = 5.0
+        fr = nt.nodes.new("ShaderNodeMath")
+        fr.operation = "MULTIPLY_ADD"
+        fr.use_clamp = False
+        nt.links.new(p5.outputs[0], fr.inputs[0])
+        fr.inputs[1].default_value = 1 - r0
+        fr.inputs[2].default_value = r0
+        sc = nt.nodes.new("ShaderNodeVectorMath")
+        sc.operation = "SCALE"
+        sc.inputs[0].default_value = tinted(w["metallic"])[:3]
+        nt.links.new(fr.outputs[0], sc.inputs["Scale"])
+        n = nt.nodes.new("ShaderNodeBsdfGlossy")
+        distribution(n)
+        nt.links.new(sc.outputs["Vector"], n.inputs["Color"])
+        lobes.append(n.outputs["BSDF"])
+    if w["reflecting"] > 0:
+        n = nt.nodes.new("ShaderNodeBsdfGlossy")
+        distribution(n)
+        n.inputs["Color"].default_value = tinted(w["reflecting"])
+        lobes.append(n.outputs["BSDF"])
+    if w["refractive"] > 0:
+        n = nt.nodes.new("ShaderNodeBsdfGlass")
+        distribution(n)
+        n.inputs["Color"].default_value = tinted(w["refractive"])
+        n.inputs["IOR"].default_value = ior
+        lobes.append(n.outputs["BSDF"])
+    out = lobes[0]
+    for s in lobes[1:]:
+        add = nt.nodes.new("ShaderNodeAddShader")
+        nt.links.new(out, add.inputs[0])
+        nt.links.new(s, add.inputs[1])
+        out = add.outputs["Shader"]
+    cache[key] = finish_material(mat, nt, out, backculled)
     return cache[key]
 
 
-def black_material(cache):
-    return diffuse_material({"character": {"diffuse": 1}, "color": [0, 0, 0]}, cache)
+def light_material(emission, backculled, cache):
+    key = ("light", tuple(emission), backculled)
+    if key not in cache:
+        mat, nt = node_material("light_%d" % len(cache))
+        peak = max(emission)
+        if peak > 0:
+            n = nt.nodes.new("ShaderNodeEmission")  # strength 1 x colour = the radiance
+            n.inputs["Color"].default_value = (*[e / peak for e in emission], 1.0)
+            n.inputs["Strength"].default_value = peak
+            out = n.outputs["Emission"]
+        else:  # a black light: an opaque black surface
+            n = nt.nodes.new("ShaderNodeBsdfDiffuse")
+            n.inputs["Color"].default_value = (0, 0, 0, 1)
+            out = n.outputs["BSDF"]
+        cache[key] = finish_material(mat, nt, out, backculled)
+    return cache[key]
 
 
 # ---------------------------------------------------------------- geometry
@@ -120,40 +464,37 @@ def link(obj):
     obj.cycles.shadow_terminator_offset = 0.0
 
 
-def add_mesh(name, verts, faces, mat):
+def add_mesh(name, verts, faces, mat, normals=None):
     me = bpy.data.meshes.new(name)
     me.from_pydata([tuple(v) for v in verts], [], faces)
     me.update()
     for poly in me.polygons:
-        poly.use_smooth = False
+        poly.use_smooth = normals is not None
+    if normals is not None:
+        # The radial directions as shading normals (custom normals need auto smooth).
+        me.use_auto_smooth = True
+        me.auto_smooth_angle = math.pi
+        me.normals_split_custom_set_from_vertices([tuple(n) for n in normals])
     me.materials.append(mat)
     obj = bpy.data.objects.new(name, me)
     link(obj)
 
 
-def add_plane(body, mat, centre_hint, half):
-    n = Vector(triple(body["normal"], "plane normal"))
-    if n.length == 0:
-        fail("plane normal is zero")
-    offset = number(body["offset"], "plane offset") / n.length
-    n.normalize()
+def plane_corners(g, centre_hint, half):
+    n, offset = g["normal"], g["offset"]
     # The point of the plane nearest the hint, and two axes in it with t x b = n.
     c = Vector(centre_hint)
     p0 = c + n * (offset - n.dot(c))
     t = n.cross(Vector((1, 0, 0)) if abs(n.x) < 0.9 else Vector((0, 1, 0))).normalized()
     b = n.cross(t)
-    corners = [p0 + half * (sx * t + sy * b) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-    add_mesh("plane", [to_blender(v) for v in corners], [(0, 1, 2, 3)], mat)
+    return [p0 + half * (sx * t + sy * b) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
 
 
-def add_sphere(body, mat):
-    centre = triple(body["center"], "sphere center")
-    r = number(body["radius"], "sphere radius")
-    if r <= 0:
-        fail("sphere radius must be positive")
-    # One vertex made a point-cloud point by geometry nodes: Cycles intersects it as a sphere.
+def add_point_sphere(g, mat):
+    # One vertex made a point-cloud point by geometry nodes: Cycles intersects it as a sphere
+    # (from outside only).
     me = bpy.data.meshes.new("sphere_centre")
-    me.from_pydata([tuple(to_blender(centre))], [], [])
+    me.from_pydata([tuple(to_blender(g["center"]))], [], [])
     obj = bpy.data.objects.new("sphere", me)
     link(obj)
     tree = bpy.data.node_groups.new("sphere_points", "GeometryNodeTree")
@@ -162,7 +503,7 @@ def add_sphere(body, mat):
     gin = tree.nodes.new("NodeGroupInput")
     gout = tree.nodes.new("NodeGroupOutput")
     pts = tree.nodes.new("GeometryNodeMeshToPoints")
-    pts.inputs["Radius"].default_value = r
+    pts.inputs["Radius"].default_value = g["radius"] * UNIT[0]
     setm = tree.nodes.new("GeometryNodeSetMaterial")
     setm.inputs["Material"].default_value = mat
     tree.links.new(gin.outputs[0], pts.inputs["Mesh"])
@@ -171,65 +512,111 @@ def add_sphere(body, mat):
     obj.modifiers.new("sphere", "NODES").node_group = tree
 
 
-GEOMETRY_KEYS = {"plane": {"normal", "offset"}, "sphere": {"center", "radius"},
-                 "triangle": {"points"}}
-SETTINGS = {"material", "background", "backculled"}
+def geodesic_unit_sphere(k):
+    """The icosahedron split k times, its vertices pushed onto the unit sphere; faces run
+    counter-clockwise seen from outside."""
+    t = (1 + 5 ** 0.5) / 2
+    verts = [Vector(v).normalized() for v in
+             ((-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
+              (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1))]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+             (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+             (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    for _ in range(k):
+        mids = {}
+
+        def mid(a, b):
+            key = (a, b) if a < b else (b, a)
+            if key not in mids:
+                mids[key] = len(verts)
+                verts.append((verts[a] + verts[b]).normalized())
+            return mids[key]
+        split = []
+        for a, b, c in faces:
+            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+            split += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        faces = split
+    for f in faces:
+        a, b, c = (verts[i] for i in f)
+        if (b - a).cross(c - a).dot(a + b + c) <= 0:
+            fail("internal: the geodesic sphere has an inward face")
+    return verts, faces
 
 
-def check_settings(body, what):
-    for k in ("background", "backculled"):
-        if body.get(k, False) is not False:
-            fail("%s: %r true is not supported (Cycles has no such rule)" % (what, k))
+def add_mesh_sphere(g, mat, k, cache):
+    if k not in cache:
+        cache[k] = geodesic_unit_sphere(k)
+    unit, faces = cache[k]
+    c, r = g["center"], g["radius"]
+    add_mesh("sphere_mesh", [to_blender(c + r * u) for u in unit], faces, mat,
+             normals=[to_blender_dir(u) for u in unit])
 
 
-def add_object(kind, body, ctx):
-    """A standalone primitive or a thing group."""
-    mat_json = None
-    prims = []
-    if kind != "thing":
-        keys_ok(body, GEOMETRY_KEYS[kind] | SETTINGS, kind)
-        check_settings(body, kind)
-        mat_json = body.get("material")
-        prims.append((kind, body))
+def split_triangle(pts, k):
+    """A triangle cut k times into four by its edges' midpoints (4^k triangles of the same
+    orientation, covering it exactly)."""
+    tris = [pts]
+    for _ in range(k):
+        nxt = []
+        for a, b, c in tris:
+            ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+            nxt += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca)]
+        tris = nxt
+    return tris
+
+
+def camera_inside(g, cam_points):
+    return any((p - g["center"]).length < g["radius"] for p in cam_points)
+
+
+def build_object(o, ctx):
+    if o.cls == "light":
+        mat = light_material(o.emission, o.backculled, ctx["materials"])
     else:
-        keys_ok(body, {"parts"} | SETTINGS, "thing")
-        check_settings(body, "thing")
-        mat_json = body.get("material")
-        parts = body.get("parts")
-        if not isinstance(parts, list) or not parts:
-            fail("thing: parts must be a non-empty list")
-        for part in parts:
-            if not isinstance(part, dict) or len(part) != 1:
-                fail("thing: each part must be a one-key object")
-            (k, v), = part.items()
-            if k in GEOMETRY_KEYS:
-                keys_ok(v, GEOMETRY_KEYS[k] | SETTINGS, "thing part " + k)
-                check_settings(v, "thing part " + k)
-                if "material" in v:
-                    mat_json = v["material"]
-                prims.append((k, v))
-            elif k == "material":
-                mat_json = v
-            elif k in ("background", "backculled"):
-                check_settings(part, "thing")
-            else:
-                fail("thing: part %r is not supported" % k)
-    mat = (diffuse_material(mat_json, ctx["materials"]) if mat_json is not None
-           else black_material(ctx["materials"]))
+        m = o.material if o.material is not None else \
+            {"character": {"diffuse": 1, "metallic": 0, "reflecting": 0, "refractive": 0},
+             "color": [0, 0, 0]}
+        mat = thing_material(m, o.backculled, ctx["materials"], o.where + ": material")
+        opaque = lobe_weights(m, o.where)["refractive"] == 0
     tris = []
-    for k, v in prims:
-        for key in GEOMETRY_KEYS[k]:
-            if key not in v:
-                fail("%s: missing %r" % (k, key))
-        if k == "plane":
-            add_plane(v, mat, ctx["lookat"], ctx["plane_size"])
-        elif k == "sphere":
-            add_sphere(v, mat)
+    for kind, g in o.parts:
+        if kind == "plane":
+            corners = plane_corners(g, ctx["view_centre"], ctx["plane_size"])
+            add_mesh("plane", [to_blender(v) for v in corners], [(0, 1, 2, 3)], mat)
+        elif kind == "sphere":
+            if o.cls == "thing" and (o.backculled or
+                                     (opaque and not camera_inside(g, ctx["cam_points"]))):
+                add_point_sphere(g, mat)
+            else:
+                add_mesh_sphere(g, mat, ctx["sphere_k"], ctx["spheres"])
+                ctx["mesh_spheres"] += 1
+        elif o.cls == "light":
+            # Cycles 3.4 samples a triangle light by its solid angle, computed with approximate
+            # arithmetic (fast_acosf), which loses light of triangles seen small or edge-on:
+            # -2% on the Cornell box's back wall, nearly all of it for small pieces seen
+            # edge-on.  It does so from points whose distance to the triangle's plane is below
+            # its longest edge times twice its area, in Blender units (kernel/light/light.h:
+            # distance_to_plane divides by |N|^2, not |N|), and samples its area, exactly,
+            # from farther.  That distance goes as the cube of the size: the scene is scaled
+            # (--scale) to make light triangles at most 1 long, and each is cut into 4^K
+            # pieces a 2^K-th of its size, K the least (at most 8) that brings the distance
+            # below 1/1000 of the triangle's longest edge.  (Many pieces instead would bias
+            # the light by float rounding in Cycles' table of cumulative areas: -0.15% with
+            # 131,072.)
+            p0, p1, p2 = (UNIT[0] * p for p in g["points"])
+            edge = max((p1 - p0).length, (p2 - p1).length, (p0 - p2).length)
+            twice_area = (p1 - p0).cross(p2 - p0).length
+            k = ctx["light_k"]
+            if k < 0:
+                k = 0
+                while k < 8 and edge * twice_area / 8 ** k > 1e-3 * edge:
+                    k += 1
+            ctx["light_pieces"] += 4 ** k
+            ctx["solid_angle_within"] = max(ctx["solid_angle_within"],
+                                            edge * twice_area / 8 ** k / UNIT[0])
+            tris += [[to_blender(p) for p in t] for t in split_triangle(g["points"], k)]
         else:
-            pts = v["points"]
-            if not isinstance(pts, list) or len(pts) != 3:
-                fail("triangle: points must be 3 triples")
-            tris.append([to_blender(triple(p, "triangle point")) for p in pts])
+            tris.append([to_blender(p) for p in g["points"]])
     if tris:
         verts = [p for t in tris for p in t]
         add_mesh("triangles", verts, [(3 * i, 3 * i + 1, 3 * i + 2) for i in range(len(tris))],
@@ -319,7 +706,7 @@ def add_sun(body):
     keys_ok(body, {"direction", "irradiance", "angle"}, "sun")
     if "direction" not in body:
         fail("sun: only a sun given by \"direction\" is supported (not \"place\")")
-    d = to_blender(triple(body["direction"], "sun direction"))
+    d = to_blender_dir(triple(body["direction"], "sun direction"))
     if d.length == 0:
         fail("sun direction is zero")
     e = triple(body.get("irradiance"), "sun irradiance")
@@ -341,46 +728,118 @@ def add_sun(body):
 
 # ---------------------------------------------------------------- camera and render
 
-def setup_camera(cam_json):
+def camera_corners(cam_json):
+    """The camera as zonetrace's four-corner form: viewpoint, TL, TR, BL, grid, view centre."""
+    def grid(default):
+        res = cam_json.get("gridresolution", default)
+        if res is None:
+            fail("camera: missing \"gridresolution\"")
+        if not (isinstance(res, list) and len(res) == 2 and
+                all(isinstance(x, int) and not isinstance(x, bool) and x > 0 for x in res)):
+            fail("camera gridresolution must be [W, H], positive integers")
+        return res
+    if "viewpoint" in cam_json or "screen" in cam_json:
+        keys_ok(cam_json, {"viewpoint", "screen", "gridresolution"},
+                "camera (the four-corner form)")
+        for k in ("viewpoint", "screen"):
+            if k not in cam_json:
+                fail("camera: missing %r" % k)
+        eye = Vector(triple(cam_json["viewpoint"], "camera viewpoint"))
+        scr = cam_json["screen"]
+        if not isinstance(scr, list) or len(scr) != 4:
+            fail("camera screen must be 4 triples (TL, TR, BL, BR)")
+        tl, tr, bl = (Vector(triple(p, "camera screen corner")) for p in scr[:3])
+        triple(scr[3], "camera screen corner")  # checked, not used, as in zonetrace
+        w, h = grid(None)
+        return eye, tl, tr, bl, w, h, tl + (tr - tl) / 2 + (bl - tl) / 2
     keys_ok(cam_json, {"position", "lookat", "up", "fov", "gridresolution"},
-            "camera (only the aimed form is supported)")
+            "camera (the aimed form)")
     for k in ("position", "lookat"):
         if k not in cam_json:
             fail("camera: missing %r" % k)
-    pos = to_blender(triple(cam_json["position"], "camera position"))
-    at = to_blender(triple(cam_json["lookat"], "camera lookat"))
-    up = to_blender(triple(cam_json.get("up", [0, 1, 0]), "camera up"))
+    eye = Vector(triple(cam_json["position"], "camera position"))
+    at = Vector(triple(cam_json["lookat"], "camera lookat"))
+    up = Vector(triple(cam_json.get("up", [0, 1, 0]), "camera up"))
     fov = number(cam_json.get("fov", 40), "camera fov")
-    res = cam_json.get("gridresolution", [512, 512])
-    if not (isinstance(res, list) and len(res) == 2 and all(isinstance(x, int) for x in res)):
-        fail("camera gridresolution must be [W, H]")
-    w, h = res
-    f = at - pos
+    if not 0 < fov < 180:
+        fail("camera fov must be between 0 and 180 degrees")
+    w, h = grid([512, 512])
+    f = at - eye
     dist = f.length
-    f.normalize()
-    r = f.cross(up).normalized()
+    if dist == 0:
+        fail("camera: position and lookat coincide")
+    f /= dist
+    r = f.cross(up)
+    if r.length <= 1e-9 * up.length:
+        fail("camera: up is zero or parallel to the view")
+    r.normalize()
     u = r.cross(f)
+    # zonetrace's zt_camera_look_at: the screen a thousandth of the distance ahead.
+    near = 1e-3 * dist
+    half_h = near * math.tan(math.radians(fov) / 2)
+    half_w = half_h * w / h
+    c = eye + near * f
+    return eye, c - half_w * r + half_h * u, c + half_w * r + half_h * u, \
+        c - half_w * r - half_h * u, w, h, at
+
+
+def setup_camera(corners, size):
+    """A pinhole through the viewpoint and the screen corners, the screen as near plane."""
+    eye, tl, tr, bl, w, h, view_centre = corners
+    if size is not None:
+        w, h = size
+    right, down = tr - tl, bl - tl
+    sw, sh = right.length, down.length
+    if sw == 0 or sh == 0 or right.cross(down).length <= 1e-10 * sw * sh:
+        fail("camera: the screen's corners are collinear")
+    if abs(right.dot(down)) > 1e-7 * sw * sh:
+        fail("camera: the screen is not a rectangle (skewed); Cycles' camera has square "
+             "corners")
+    x, y = right / sw, -down / sh
+    z = x.cross(y)  # Blender's camera looks along its -Z
+    dist = (eye - tl).dot(z)
+    if dist <= 0:
+        fail("camera: the viewpoint is on the side of the screen from which the image is "
+             "mirrored (or in its plane); Cycles' camera cannot mirror")
+    centre = tl + right / 2 + down / 2
+    axis = eye - dist * z  # the foot of the eye on the screen's plane
+    shift_x, shift_y = (centre - axis).dot(x) / sw, (centre - axis).dot(y) / sw
     cam = bpy.data.cameras.new("camera")
     cam.type = "PERSP"
-    cam.sensor_fit = "VERTICAL"  # fov is the vertical angle, as ours
-    cam.sensor_height = 24.0
-    cam.lens = cam.sensor_height / 2 / math.tan(math.radians(fov) / 2)
-    cam.shift_x = cam.shift_y = 0.0
-    cam.clip_start = 1e-3 * dist  # zonetrace's near plane
-    cam.clip_end = 1e8
+    # The screen's width fixes the field (horizontal fit); its height follows from the
+    # aspect of the grid times the pixels' aspect.  Shifts are in screen widths.
+    cam.sensor_fit = "HORIZONTAL"
+    cam.sensor_width = 36.0
+    cam.lens = 36.0 * dist / sw
+    if abs(cam.lens - 36.0 * dist / sw) > 1e-5 * cam.lens:
+        fail("camera: a field of view of %.6g degrees is beyond Blender's lens range"
+             % math.degrees(2 * math.atan(sw / 2 / dist)))
+    cam.shift_x, cam.shift_y = shift_x, shift_y
+    cam.clip_start = dist * UNIT[0]  # zonetrace's rays start on the screen
+    cam.clip_end = max(1e8, 1e3 * dist) * UNIT[0]
+    pixel_aspect = (sw / w) / (sh / h)
     obj = bpy.data.objects.new("camera", cam)
-    obj.matrix_world = Matrix(((r.x, u.x, -f.x, pos.x), (r.y, u.y, -f.y, pos.y),
-                               (r.z, u.z, -f.z, pos.z), (0, 0, 0, 1)))
+    xb, yb, zb, pb = to_blender_dir(x), to_blender_dir(y), to_blender_dir(z), to_blender(eye)
+    obj.matrix_world = Matrix(((xb.x, yb.x, zb.x, pb.x), (xb.y, yb.y, zb.y, pb.y),
+                               (xb.z, yb.z, zb.z, pb.z), (0, 0, 0, 1)))
     bpy.context.scene.collection.objects.link(obj)
     bpy.context.scene.camera = obj
-    return w, h, triple(cam_json["lookat"], "camera lookat")
+    return w, h, pixel_aspect
 
 
-def render_settings(s, w, h, args):
+def render_settings(s, w, h, pixel_aspect, args):
     s.render.engine = "CYCLES"
     s.render.resolution_x, s.render.resolution_y = w, h
     s.render.resolution_percentage = 100
-    s.render.pixel_aspect_x = s.render.pixel_aspect_y = 1.0
+    # Blender wants both aspects at least 1: the larger one carries the ratio.
+    if pixel_aspect >= 1:
+        s.render.pixel_aspect_x, s.render.pixel_aspect_y = pixel_aspect, 1.0
+    else:
+        s.render.pixel_aspect_x, s.render.pixel_aspect_y = 1.0, 1.0 / pixel_aspect
+    got = s.render.pixel_aspect_x / s.render.pixel_aspect_y
+    if abs(got - pixel_aspect) > 1e-6 * pixel_aspect:
+        fail("camera: a pixel aspect of %.6g is beyond Blender's range (1/200 to 200)"
+             % pixel_aspect)
     s.render.use_border = False
     s.render.use_motion_blur = False
     s.render.film_transparent = False
@@ -431,43 +890,75 @@ def write_pfm(path, w, h, rgba):
         f.write(rgb.tobytes())  # Blender's rows run bottom to top, as PFM's
 
 
+def parse_size(text):
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        fail("--size must be WxH, not %r" % text)
+    if w <= 0 or h <= 0:
+        fail("--size must be positive")
+    return w, h
+
+
 def main(argv):
     ap = argparse.ArgumentParser(prog="blender -b -P tools/cycles_reference.py --")
     ap.add_argument("scene")
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, required=True)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--size", help="WxH: the pixel grid instead of gridresolution")
     ap.add_argument("--bounces", type=int, default=16, help="Cycles max bounces (all kinds)")
     ap.add_argument("--plane-size", type=float, default=10000.0, help="planes' half-size")
+    ap.add_argument("--light-offset", type=float, default=0.01,
+                    help="how far a foreground triangle lying in a background plane is moved "
+                         "off it (0: not moved)")
+    ap.add_argument("--sphere-subdivisions", type=int, default=6,
+                    help="K: spheres that must be meshes get 20 x 4^K triangles")
+    ap.add_argument("--light-subdivisions", type=int, default=-1,
+                    help="K: each light triangle is cut into 4^K pieces (default: chosen per "
+                         "triangle, see build_object)")
+    ap.add_argument("--scale", default="auto",
+                    help="Blender units per scene unit (default: the power of 2 that makes "
+                         "light triangles at most 1 long, see build_object)")
+    ap.add_argument("--ggx", choices=("multi", "single"), default="multi",
+                    help="rough lobes: Multiscatter GGX (default), or single-scattering GGX "
+                         "(to compare with a zonetrace built without its compensation)")
     ap.add_argument("--threads", type=int, default=0, help="render threads (0: all)")
     args = ap.parse_args(argv)
+    GGX_KIND[0] = "MULTI_GGX" if args.ggx == "multi" else "GGX"
+    if not 0 <= args.sphere_subdivisions <= 8:
+        fail("--sphere-subdivisions must be 0 to 8")
+    if not -1 <= args.light_subdivisions <= 8:
+        fail("--light-subdivisions must be 0 to 8 (or -1: chosen per triangle)")
 
     with open(args.scene) as f:
         try:
             doc = json.load(f)
         except ValueError as e:
-            fail("%s: not JSON this script reads (%s)" % (args.scene, e))
+            fail("%s: not JSON this script reads (the legacy group syntax is not supported): "
+                 "%s" % (args.scene, e))
     keys_ok(doc, {"camera", "scene"}, "top level")
     if "camera" not in doc or "scene" not in doc:
         fail("top level: needs \"camera\" and \"scene\"")
+    if not isinstance(doc["scene"], list):
+        fail("\"scene\" must be a list")
 
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    s = bpy.context.scene
-    w, h, lookat = setup_camera(doc["camera"])
-    ctx = {"materials": {}, "lookat": lookat, "plane_size": args.plane_size}
-    sky = None
-    have_sun = False
-    for item in doc["scene"]:
+    corners = camera_corners(doc["camera"])
+    eye, tl, tr, bl, _, _, view_centre = corners
+    cam_points = [eye, tl, tr, bl, tr + bl - tl]
+    objs = []
+    sky = sun = None
+    for index, item in enumerate(doc["scene"]):
         if not isinstance(item, dict) or len(item) != 1:
             fail("each scene item must be a one-key object, not %r" % (item,))
         (kind, body), = item.items()
-        if kind in GEOMETRY_KEYS or kind == "thing":
-            add_object(kind, body, ctx)
+        if kind in THING_PRIMS or kind in LIGHT_PRIMS or kind in ("thing", "light",
+                                                                   "lightpoint"):
+            objs.append(parse_item(kind, body, index))
         elif kind == "sun":
-            if have_sun:
+            if sun is not None:
                 fail("a second sun")
-            add_sun(body)
-            have_sun = True
+            sun = body
         elif kind == "sky":
             if sky is not None:
                 fail("a second sky")
@@ -476,8 +967,43 @@ def main(argv):
             sky = body
         else:
             fail("scene item %r is not supported by this script" % kind)
+    nbg = check_background(objs, cam_points, args.light_offset)
+    moved = sum(1 for o in objs for _, g in o.parts if g.get("moved"))
+    if args.scale == "auto":
+        # Light triangles at most 1 long (see build_object), by a power of 2: exact in float.
+        longest = max([max((p1 - p0).length, (p2 - p1).length, (p0 - p2).length)
+                       for o in objs if o.cls == "light" for kind, g in o.parts
+                       if kind == "triangle" for p0, p1, p2 in [g["points"]]] +
+                      [1.1 * g["radius"] / 2 ** args.sphere_subdivisions  # geodesic edges
+                       for o in objs if o.cls == "light" for kind, g in o.parts
+                       if kind == "sphere"] + [1.0])
+        UNIT[0] = 2.0 ** -math.ceil(math.log2(longest))
+    else:
+        UNIT[0] = number(float(args.scale), "--scale")
+        if not UNIT[0] > 0:
+            fail("--scale must be positive")
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    s = bpy.context.scene
+    w, h, pixel_aspect = setup_camera(corners, parse_size(args.size) if args.size else None)
+    ctx = {"materials": {}, "view_centre": view_centre, "plane_size": args.plane_size,
+           "cam_points": cam_points, "sphere_k": args.sphere_subdivisions, "spheres": {},
+           "mesh_spheres": 0, "light_k": args.light_subdivisions, "light_pieces": 0,
+           "solid_angle_within": 0.0}
+    for o in objs:
+        build_object(o, ctx)
+    if sun is not None:
+        add_sun(sun)
     setup_world(sky, os.path.dirname(os.path.abspath(args.scene)))
-    render_settings(s, w, h, args)
+    render_settings(s, w, h, pixel_aspect, args)
+    print("cycles_reference: %d objects (%d lights), %d background planes, %d triangles moved "
+          "%g off them, %d spheres as meshes of %d triangles"
+          % (len(objs), sum(o.cls == "light" for o in objs), nbg, moved, args.light_offset,
+             ctx["mesh_spheres"], 20 * 4 ** args.sphere_subdivisions))
+    if ctx["light_pieces"]:
+        print("cycles_reference: scale %g; light triangles cut into %d pieces: Cycles samples "
+              "their solid angle (inexactly) only within %.3g scene units of their planes"
+              % (UNIT[0], ctx["light_pieces"], ctx["solid_angle_within"]))
 
     exr_out = args.out.lower().endswith(".exr")
     tmp = None
