@@ -1033,11 +1033,12 @@ static int files_equal(const char *a, const char *b)
     return eq;
 }
 
-static void test_render_animation(void **state)
+/* The scene the animations render: a lit sphere on a floor, 24 x 24,
+ * with the camera given as JSON text. */
+static const char *write_lit_sphere(const char *name, const char *camera)
 {
-    (void)state;
-    char scene[512], motions[512];
-    snprintf(scene, sizeof scene, "%s", test_write_file("anim_scene.json",
+    char text[2048];
+    snprintf(text, sizeof text,
         "{\"scene\": [\n"
         "  {\"lightsphere\": {\"center\": [0, 3, 0], \"radius\": 0.5, \"emission\": [20, 20, 20]}},\n"
         "  {\"sphere\": {\"center\": [2, 0, 0], \"radius\": 1,\n"
@@ -1047,9 +1048,18 @@ static void test_render_animation(void **state)
         "    \"material\": {\"character\": {\"diffuse\": 1, \"metallic\": 0, \"reflecting\": 0, \"refractive\": 0},\n"
         "                 \"color\": [0.5, 0.5, 0.5]}}}\n"
         "],\n"
-        "\"camera\": {\"viewpoint\": [0, 1, -10],\n"
+        "\"camera\": %s}\n", camera);
+    return test_write_file(name, text);
+}
+
+static void test_render_animation(void **state)
+{
+    (void)state;
+    char scene[512], motions[512];
+    snprintf(scene, sizeof scene, "%s", write_lit_sphere("anim_scene.json",
+        "{\"viewpoint\": [0, 1, -10],\n"
         "  \"screen\": [[-2, 3, -6], [2, 3, -6], [-2, -1, -6], [2, -1, -6]],\n"
-        "  \"gridresolution\": [24, 24]}}\n"));
+        "  \"gridresolution\": [24, 24]}"));
     snprintf(motions, sizeof motions, "%s", test_write_file("anim_motions.json",
         "{\"motions\": [{\"thing\": 0, \"type\": \"orbiting\", \"axis\": \"y\", \"period\": 4},\n"
         "              {\"light\": 0, \"type\": \"brownian\", \"scale\": 1}]}\n"));
@@ -1110,25 +1120,6 @@ static void test_render_animation(void **state)
              motions, test_tmp_dir());
     assert_int_equal(test_run_cli(args, &err), 1);
     free(err);
-}
-
-/* The scene of the camera path renders: a lit sphere on a floor, 24 x 24,
- * with the camera given as JSON text. */
-static const char *write_lit_sphere(const char *name, const char *camera)
-{
-    char text[2048];
-    snprintf(text, sizeof text,
-        "{\"scene\": [\n"
-        "  {\"lightsphere\": {\"center\": [0, 3, 0], \"radius\": 0.5, \"emission\": [20, 20, 20]}},\n"
-        "  {\"sphere\": {\"center\": [2, 0, 0], \"radius\": 1,\n"
-        "    \"material\": {\"character\": {\"diffuse\": 1, \"metallic\": 0, \"reflecting\": 0, \"refractive\": 0},\n"
-        "                 \"color\": [0.8, 0.8, 0.8]}}},\n"
-        "  {\"plane\": {\"normal\": [0, 1, 0], \"offset\": -1,\n"
-        "    \"material\": {\"character\": {\"diffuse\": 1, \"metallic\": 0, \"reflecting\": 0, \"refractive\": 0},\n"
-        "                 \"color\": [0.5, 0.5, 0.5]}}}\n"
-        "],\n"
-        "\"camera\": %s}\n", camera);
-    return test_write_file(name, text);
 }
 
 /* Three keys one second apart; the first takes the default up and fov. */

@@ -88,6 +88,13 @@ static inline int bsdf_lobe_rough(const rs_object *m, int k)
            !(k == LOBE_REFRACTIVE && m->thin);
 }
 
+/* Lobe k's weight if it is smooth, else 0: what the deterministic
+ * reflected and refracted rays carry beside the rough lobes. */
+static inline float bsdf_smooth_weight(const rs_object *m, int k)
+{
+    return bsdf_lobe_rough(m, k) ? 0.0f : m->weight[k];
+}
+
 /* m's rough lobes for light arriving from wi and leaving toward wo (next-
  * event estimation): for each such lobe k, fcos[k] = weight x f x |cos_i|
  * (the colour apart) and pdf[k] = weight x the density of the lobe choosing

@@ -179,9 +179,8 @@ static void rough_on(tracer *t, const rs_part *p, int part, vec3f xf, vec3f nf, 
 {
     const rscene *rs = t->rs;
     const rs_object *m = &rs->objects[p->object];
-    int entering = media_count == 0 || media[media_count - 1] != p->object;
-    float eta_i = media_count ? rs->objects[media[media_count - 1]].ior : 1.0f;
-    float eta_t = entering ? m->ior : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
+    float eta_i, eta_t;
+    int entering = media_indices(rs, media, media_count, p->object, m, &eta_i, &eta_t);
     rs_shade sh = {nf, m->color};
     if (rs_needs_shade(rs, part, m))
         rs_shade_at(rs, part, p, m, xf, nf, &sh);
@@ -249,20 +248,14 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
      * is left for it. */
     if (k + 1 >= t->f->map_levels || k + 1 > LEVEL_MAX)
         return;
-    float wm = m->weight[LOBE_METALLIC], wr = m->weight[LOBE_REFLECTING];
-    float wt = m->weight[LOBE_REFRACTIVE];
+    /* Rough lobes send the photon on in one direction drawn from them
+     * (zone_rough_scatter), the smooth ones below the rest. */
+    if (m->rough)
+        rough_on(t, p, h.part, xf, nf, d, flux, share, k, media, media_count);
+    float wm = bsdf_smooth_weight(m, LOBE_METALLIC), wr = bsdf_smooth_weight(m, LOBE_REFLECTING);
+    float wt = bsdf_smooth_weight(m, LOBE_REFRACTIVE);
     if (wm <= 0.0f && wr <= 0.0f && wt <= 0.0f)
         return;
-    if (m->rough) {
-        /* Rough lobes send the photon on in one direction drawn from them
-         * (zone_rough_scatter), the smooth ones below the rest. */
-        rough_on(t, p, h.part, xf, nf, d, flux, share, k, media, media_count);
-        wm = wr = 0.0f;
-        if (!m->thin)
-            wt = 0.0f;
-        if (wt <= 0.0f)
-            return;
-    }
     /* The same lobes and weights as zone_radiance, seen from the light's
      * side (Fresnel and Schlick are reciprocal). */
     float cos_o = -f3_dot(nf, d);
@@ -270,9 +263,8 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     double k_refl = wr, k_tran = 0;
     if (wm > 0.0f)
         k_refl += wm * bsdf_schlick(cos_o, m->ior);
-    int entering = media_count == 0 || media[media_count - 1] != p->object;
-    float eta_i = media_count ? rs->objects[media[media_count - 1]].ior : 1.0f;
-    float eta_t = entering ? m->ior : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
+    float eta_i, eta_t;
+    int entering = media_indices(rs, media, media_count, p->object, m, &eta_i, &eta_t);
     if (wt > 0.0f && m->thin) {
         k_refl += wt * bsdf_pane_reflectance(cos_o, m->ior);
     } else if (wt > 0.0f) {

@@ -7,6 +7,7 @@
 
 #include <math.h>
 
+#include "render/render_scene.h"
 #include "util/vec3f.h"
 
 #define MEDIA_MAX 8 /* the deepest nesting followed */
@@ -18,6 +19,18 @@ static inline vec3f media_refract(vec3f d, vec3f nf, float cos_o, float eta)
     float sin2 = eta * eta * (1.0f - cos_o * cos_o);
     float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2));
     return f3_normalize(f3_sub(f3_scale(d, eta), f3_scale(nf, cos_t - eta * cos_o)));
+}
+
+/* At a surface of `object` (material m) met inside media[0..count): whether
+ * the ray enters it, and the indices on its side (*eta_i) and beyond
+ * (*eta_t). */
+static inline int media_indices(const rscene *rs, const int *media, int count, int object,
+                                const rs_object *m, float *eta_i, float *eta_t)
+{
+    int entering = count == 0 || media[count - 1] != object;
+    *eta_i = count ? rs->objects[media[count - 1]].ior : 1.0f;
+    *eta_t = entering ? m->ior : (count > 1 ? rs->objects[media[count - 2]].ior : 1.0f);
+    return entering;
 }
 
 /* The stack after crossing object's surface: media[0..count) into next,

@@ -104,13 +104,8 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
     }
 
     /* Smooth lobes here; rough ones (m->rough: all but a pane's) below. */
-    float wm = m->weight[LOBE_METALLIC], wr = m->weight[LOBE_REFLECTING];
-    float wt = m->weight[LOBE_REFRACTIVE];
-    if (m->rough) {
-        wm = wr = 0.0f;
-        if (!m->thin)
-            wt = 0.0f;
-    }
+    float wm = bsdf_smooth_weight(m, LOBE_METALLIC), wr = bsdf_smooth_weight(m, LOBE_REFLECTING);
+    float wt = bsdf_smooth_weight(m, LOBE_REFRACTIVE);
     if ((hi >= 1 || m->thin) && (wm > 0.0f || wr > 0.0f || wt > 0.0f)) {
         vec3f ng_facing = nf;
         nf = sh.ns;
@@ -122,10 +117,8 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         if (wm > 0.0f)
             k_refl += wm * bsdf_schlick(cos_o, m->ior);
         double k_tran = 0;
-        int entering = media_count == 0 || media[media_count - 1] != p->object;
-        float eta_i = media_count ? rs->objects[media[media_count - 1]].ior : 1.0f;
-        float eta_t = entering ? m->ior
-                               : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
+        float eta_i, eta_t;
+        int entering = media_indices(rs, media, media_count, p->object, m, &eta_i, &eta_t);
         vec3 pass = v3(0, 0, 0);
         if (wt > 0.0f && m->thin) {
             float fr = bsdf_pane_reflectance(cos_o, m->ior);
@@ -165,12 +158,9 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         }
     }
     if (m->rough && hi >= 1) {
-        int entering = media_count == 0 || media[media_count - 1] != p->object;
-        zone_rough_at at = {m, h.part, xf, back ? f3_neg(ngf) : ngf, sh.ns, color, d,
-                            media_count ? rs->objects[media[media_count - 1]].ior : 1.0f,
-                            1.0f, p->object, entering, media, media_count};
-        at.eta_t = entering ? m->ior
-                            : (media_count > 1 ? rs->objects[media[media_count - 2]].ior : 1.0f);
+        zone_rough_at at = {m, h.part, xf, back ? f3_neg(ngf) : ngf, sh.ns, color, d, 1.0f,
+                            1.0f, p->object, 0, media, media_count};
+        at.entering = media_indices(rs, media, media_count, p->object, m, &at.eta_i, &at.eta_t);
         out = v3_add(out, zone_rough_radiance(t, &at, ~0u, lo - 1, hi - 1, flags));
     }
     return out;

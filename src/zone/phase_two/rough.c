@@ -12,9 +12,9 @@
  * each, no forest) and as many light samples (the path tracer's
  * next-event choice, from the same kind of sequence), the two weighed by
  * the power heuristic, so that a lobe far narrower than a light and a
- * light far smaller than a lobe both come out right.  The lobes share one density, the weighted mixture that
- * chooses among them, and a direction's value is the sum of every lobe's
- * f cos over it (one-sample MIS over the lobes: a rough glass's reflection
+ * light far smaller than a lobe both come out right.  The lobes share one
+ * density, the weighted mixture that chooses among them, and a direction's
+ * value is the sum of every lobe's f cos over it (one-sample MIS over the lobes: a rough glass's reflection
  * and transmission count wherever either sends light).
  *
  * How many directions: a camera sample's share of its pixel's
