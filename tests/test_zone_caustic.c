@@ -13,6 +13,7 @@
 
 #include "render/render_internal.h"
 #include "zone/phase_one/caustic.h"
+#include "zone/phase_one/specular_targets.h"
 #include "zone/zone.h"
 #include "zonetrace/render.h"
 #include "zonetrace/scene.h"
@@ -107,8 +108,8 @@ static void test_caustic_matches_integral(void **state)
     (void)state;
     zt_scene *s = load();
     zt_renderer *lo = make(s, 2, 0), *hi = make(s, 2, 2);
-    assert_true(caustic_target(&lo->rs, 1));
-    assert_false(caustic_target(&lo->rs, 2));
+    assert_true(specular_target_part(&lo->rs, 1));
+    assert_false(specular_target_part(&lo->rs, 2));
     double sum_hi = 0, max_hi = 0, cusp_lo = 0, cusp_hi = 0;
     int n = 0;
     for (int k = -8; k <= 8; k++, n++) {

@@ -110,6 +110,12 @@ typedef struct zone_forest {
     sender_tree light_tree; /* the lights, when there are many */
     zone_quality q;
     int need_gather;    /* some light arrives by specular surfaces */
+    /* What that light can come from, for aiming (Phase One only, not kept
+     * in forest files): the targets' bounding spheres, and whether some
+     * specular primitive is no target (a plane). */
+    struct specular_target *spec_targets;
+    int spec_target_count;
+    int spec_unaimable;
     int specular;       /* some object has a metallic, reflecting or
                            refractive lobe */
     int sky;            /* the sky is not black: E_0 gathers it */

@@ -15,6 +15,7 @@
 #include "util/vec3_convert.h"
 #include "zone/phase_two/media.h"
 #include "zone/phase_one/glint.h"
+#include "zone/phase_one/specular_targets.h"
 
 #define PI_D 3.14159265358979323846
 #define CHUNK 1024        /* photons per work item */
@@ -24,21 +25,6 @@
                              two, and deep levels would otherwise follow 2^k
                              branches per photon (what is dropped is lost) */
 #define LEVEL_MAX 250     /* deposits keep their level in a byte */
-
-static int specular(const rs_object *m)
-{
-    return m->weight[LOBE_REFLECTING] > 0.0f || m->weight[LOBE_METALLIC] > 0.0f ||
-           m->weight[LOBE_REFRACTIVE] > 0.0f;
-}
-
-int caustic_target(const rscene *rs, int i)
-{
-    rs_part tmp;
-    const rs_part *p = rs_prim(rs, i, &tmp);
-    if (p->is_light || (p->shape != SHAPE_TRIANGLE && p->shape != SHAPE_SPHERE))
-        return 0;
-    return specular(&rs->objects[p->object]);
-}
 
 /* Flux arriving at one node at one level (a photon's share of it). */
 typedef struct deposit {
@@ -52,15 +38,6 @@ typedef struct deposits {
     size_t n, cap;
     int failed;
 } deposits;
-
-/* What photons are aimed at: a part (a triangle or sphere), or a whole
- * mesh's specular triangles (aimed at by its bounding sphere). */
-typedef struct target {
-    int part;           /* -1 for a mesh */
-    int mesh;           /* rs->meshes index, -1 for a part */
-    vec3 c;             /* bounding sphere */
-    double r;
-} target;
 
 /* One (light, target) pair, its photon count and the light's emission
  * whether switched off or not. */
@@ -80,7 +57,7 @@ typedef struct job {
 typedef struct tracer {
     const zone_forest *f;
     const rscene *rs;
-    const target *targets;
+    const specular_target *targets;
     deposits *out;
     uint64_t rays;
 } tracer;
@@ -100,27 +77,6 @@ static void basis(vec3 w, vec3 *t, vec3 *b)
 {
     *t = v3_normalize(v3_cross(fabs(w.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0), w));
     *b = v3_cross(w, *t);
-}
-
-/* 1 - cos of the half-angle of a sphere of radius r seen from distance
- * d > r, without cancellation for small cones. */
-static double cone_omc(double r, double d)
-{
-    double s2 = (r / d) * (r / d);
-    return s2 < 1e-3 ? 0.5 * s2 + 0.125 * s2 * s2 : 1.0 - sqrt(fmax(0.0, 1.0 - s2));
-}
-
-/* A sphere around a triangle or sphere part. */
-static void bounding_sphere(const rs_part *p, vec3 *c, double *r)
-{
-    if (p->shape == SHAPE_SPHERE) {
-        *c = f3_to_v3(p->p0);
-        *r = p->radius;
-        return;
-    }
-    vec3 a = f3_to_v3(p->p0), b = v3_add(a, f3_to_v3(p->e1)), d = v3_add(a, f3_to_v3(p->e2));
-    *c = v3_scale(v3_add(v3_add(a, b), d), 1.0 / 3.0);
-    *r = fmax(v3_length(v3_sub(a, *c)), fmax(v3_length(v3_sub(b, *c)), v3_length(v3_sub(d, *c))));
 }
 
 static void push(deposits *o, deposit dep)
@@ -162,16 +118,9 @@ static void deposit_at(tracer *t, int prim, int level, int side, vec3 x, vec3 fl
                                 (float)(flux.z * w[k])}});
 }
 
-/* Whether the ray's first hit is on the target. */
-static int on_target(const rscene *rs, const target *tg, int prim)
-{
-    if (tg->part >= 0)
-        return prim == tg->part;
-    return prim >= rs->part_count && rs_mesh_of(rs, prim) == &rs->meshes[tg->mesh];
-}
 
 static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
-                   int glint, const target *first, const int *media, int media_count);
+                   int glint, const specular_target *first, const int *media, int media_count);
 
 /* A photon's flux leaving part p's rough lobes at xf (nf facing it). */
 static void rough_on(tracer *t, const rs_part *p, int part, vec3f xf, vec3f nf, vec3f d,
@@ -212,12 +161,12 @@ static void rough_on(tracer *t, const rs_part *p, int part, vec3f xf, vec3f nf, 
  * reflection off the outside of a glint sphere, which glint.c accounts for
  * when it lands on a texel. */
 static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
-                   int glint, const target *first, const int *media, int media_count)
+                   int glint, const specular_target *first, const int *media, int media_count)
 {
     const rscene *rs = t->rs;
     hit h = accel_intersect(rs, o, d);
     t->rays++;
-    if (h.part < 0 || (first && !on_target(rs, first, h.part)))
+    if (h.part < 0 || (first && !specular_target_hit(rs, first, h.part)))
         return;
     rs_part tmp;
     const rs_part *p = rs_prim(rs, h.part, &tmp);
@@ -303,7 +252,7 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
 static void shoot(tracer *t, const pair *pr, int i)
 {
     const rscene *rs = t->rs;
-    const target *tg = &t->targets[pr->target];
+    const specular_target *tg = &t->targets[pr->target];
     rs_part ltmp;
     const rs_part *lp = rs_prim(rs, pr->light, &ltmp);
     const rs_part *tp = tg->part >= 0 ? &rs->parts[tg->part] : NULL;
@@ -343,7 +292,7 @@ static void shoot(tracer *t, const pair *pr, int i)
         double dist = v3_length(to);
         if (dist <= rt)
             return;
-        double omc = cone_omc(rt, dist);
+        double omc = specular_cone_omc(rt, dist);
         double z = 1.0 - u1 * omc, s = sqrt(fmax(0.0, u1 * omc * (2.0 - u1 * omc)));
         vec3 axis = v3_scale(to, 1.0 / dist);
         basis(axis, &a, &b);
@@ -388,42 +337,8 @@ static int sends_photons(const rscene *rs, const rs_part *lp)
            f3_max(rs->objects[lp->object].emission) > 0;
 }
 
-/* The targets: specular parts, and meshes with a specular material. */
-static int make_targets(const rscene *rs, target **out)
-{
-    target *tg = malloc(((size_t)rs->part_count + rs->mesh_count + 1) * sizeof *tg);
-    if (!tg)
-        return -1;
-    int n = 0;
-    for (int i = 0; i < rs->part_count; i++)
-        if (caustic_target(rs, i)) {
-            tg[n].part = i;
-            tg[n].mesh = -1;
-            bounding_sphere(&rs->parts[i], &tg[n].c, &tg[n].r);
-            n++;
-        }
-    for (int k = 0; k < rs->mesh_count; k++) {
-        const rs_mesh *mm = &rs->meshes[k];
-        int any = 0;
-        if (!mm->is_light)
-            for (int s = 0; s < mm->m->slot_count && !any; s++)
-                any = specular(&rs->objects[mm->object_base + s]);
-        if (!any)
-            continue;
-        vec3 lo, hi;
-        mesh_bounds(mm->m, &lo, &hi);
-        tg[n].part = -1;
-        tg[n].mesh = k;
-        tg[n].c = v3_scale(v3_add(lo, hi), 0.5);
-        tg[n].r = 0.5 * v3_length(v3_sub(hi, lo)) * 1.0001;
-        n++;
-    }
-    *out = tg;
-    return n;
-}
-
 /* A target's colour and specular weight (a mesh: its brightest slot). */
-static double target_catch(const rscene *rs, const target *tg)
+static double target_catch(const rscene *rs, const specular_target *tg)
 {
     double best = 0;
     int first = tg->part >= 0 ? rs->parts[tg->part].object : rs->meshes[tg->mesh].object_base;
@@ -446,7 +361,7 @@ static double target_catch(const rscene *rs, const target *tg)
  * not take thousands of times the photons. */
 #define LIGHTS_FULL 8
 #define FLOOR_MANY 16
-static int make_pairs(const zone_forest *f, const rscene *rs, const target *tg, int targets,
+static int make_pairs(const zone_forest *f, const rscene *rs, const specular_target *tg, int targets,
                       pair **out)
 {
     int lights = 0;
@@ -474,7 +389,7 @@ static int make_pairs(const zone_forest *f, const rscene *rs, const target *tg, 
         vec3 em = f3_to_v3(rs->objects[lp->object].emission);
         vec3 cl;
         double rl, total = 0;
-        bounding_sphere(lp, &cl, &rl);
+        part_bounding_sphere(lp, &cl, &rl);
         for (int i = 0; i < targets; i++) {
             imp[i] = 0;
             if (tg[i].part == li)
@@ -483,7 +398,7 @@ static int make_pairs(const zone_forest *f, const rscene *rs, const target *tg, 
             if (c <= 0)
                 continue;
             double dist = v3_length(v3_sub(tg[i].c, cl));
-            double omega = dist <= tg[i].r + rl ? 2.0 * PI_D : 2.0 * PI_D * cone_omc(tg[i].r, dist);
+            double omega = dist <= tg[i].r + rl ? 2.0 * PI_D : 2.0 * PI_D * specular_cone_omc(tg[i].r, dist);
             imp[i] = omega * c;
             total += imp[i];
         }
@@ -593,8 +508,8 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
     const rscene *rs = &r->rs;
     if (f->map_levels < 2)
         return ZT_OK;
-    target *targets = NULL;
-    int ntargets = make_targets(rs, &targets);
+    specular_target *targets = NULL;
+    int ntargets = specular_targets_make(rs, &targets, NULL);
     if (ntargets < 0)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for caustics");
     if (ntargets == 0) {

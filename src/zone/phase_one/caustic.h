@@ -6,9 +6,7 @@
  * at the ball, which a fixed low-discrepancy set of rays samples evenly.
  *
  * For every emitting triangle or sphere light and every specular target
- * (a part other than a plane with mirror, metallic or refractive weight,
- * or a mesh with such a material),
- * rays from points on the light towards the target (its bounding cone, or
+ * (specular_targets.h), rays from points on the light towards the target (its bounding cone, or
  * points on a triangle part) that hit the target first are followed through
  * every specular interaction (glass: both the reflected and the transmitted
  * ray, with Fresnel weights).  Where a ray meets a diffuse surface after
@@ -21,12 +19,6 @@
 #define ZT_ZONE_CAUSTIC_H
 
 #include "zone/zone.h"
-
-/* Whether primitive i is what photons are aimed at: not a light, not a
- * plane, with a specular lobe (a mesh's triangles are aimed at as one).  A
- * gather ray that meets a triangle or sphere light right after such a
- * primitive (and after no diffuse event) counts nothing. */
-int caustic_target(const rscene *rs, int i);
 
 /* Adds the caustic irradiance of levels 1..f->map_levels-1 onto the nodes
  * (f->e, which holds zeros or other light of the same levels; the nodes'

@@ -15,6 +15,7 @@
 #include "util/vec3_convert.h"
 #include "geom/ray_offset.h"
 #include "zone/phase_one/glint.h"
+#include "zone/phase_one/specular_targets.h"
 #include "zone/transfer/bounce_gather.h"
 #include "zone/transfer/cut.h"
 #include "zone/zone.h"
@@ -308,6 +309,11 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
              o->weight[LOBE_REFRACTIVE] > 0))
             f->need_gather = 1;
     }
+    if (f->need_gather) {
+        f->spec_target_count = specular_targets_make(rs, &f->spec_targets, &f->spec_unaimable);
+        if (f->spec_target_count < 0)
+            return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    }
     /* Where the scene has specular lobes, the light that the gathers on
      * meshes leave out (caustics, glints) is kept apart in f->c for them
      * to add (phase_one.c). */
@@ -342,6 +348,7 @@ void zone_forest_free(zone_forest *f)
     free(f->e);
     free(f->c);
     free(f->glint_spheres);
+    free(f->spec_targets);
     free(f->dirs);
     free(f->bounce_dirs);
     free(f->sky_dirs);

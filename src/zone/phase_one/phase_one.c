@@ -31,6 +31,7 @@
 #include "zone/phase_one/caustic.h"
 #include "zone/phase_one/glint.h"
 #include "zone/phase_one/node_life.h"
+#include "zone/phase_one/specular_gather.h"
 #include "zone/transfer/bounce_gather.h"
 #include "zone/transfer/sender_tree.h"
 #include "zone/transfer/transfer.h"
@@ -98,24 +99,6 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
     return v3(rs->sky.x * (3.14159265358979 * open.x / f->q.gather),
               rs->sky.y * (3.14159265358979 * open.y / f->q.gather),
               rs->sky.z * (3.14159265358979 * open.z / f->q.gather));
-}
-
-/* Light arriving at level `level` by way of specular surfaces: gathered
- * over the fixed directions, diffuse surfaces left to the transfer. */
-static vec3 specular_gather(zone_trace *t, vec3 x, vec3 n, int level)
-{
-    const zone_forest *f = t->f;
-    vec3 tt, bb;
-    v3_frame(n, &tt, &bb);
-    vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
-    vec3 sum = v3(0, 0, 0);
-    for (int k = 0; k < f->q.gather; k++) {
-        const vec3 *dk = &f->dirs[k];
-        vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
-        sum = v3_add(sum, zone_radiance(t, o, v3_to_f3(v3_normalize(d)), level, level,
-                                        ZR_SKIP_DIFFUSE | ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0));
-    }
-    return v3_scale(sum, 3.14159265358979 / f->q.gather);
 }
 
 /* Mesh vertex nodes share a cut (node_groups.h) within GROUP_RADIUS x h
@@ -236,7 +219,7 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
                                        f->q.glint_cuts));
     /* (A gather read the specular chains along its own rays.) */
     if (!*gathered && f->need_gather)
-        e = v3_add(e, specular_gather(&t, x, n, level));
+        e = v3_add(e, zone_specular_gather(&t, x, n, level));
     *rays += t.rays;
     return e;
 }

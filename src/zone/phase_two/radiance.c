@@ -20,7 +20,7 @@
 #include "render/prim.h"
 #include "util/vec3_convert.h"
 #include "zone/phase_two/media.h"
-#include "zone/phase_one/caustic.h"
+#include "zone/phase_one/specular_targets.h"
 #include "zone/phase_one/glint.h"
 
 
@@ -133,7 +133,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
          * the rays that leave a caustic target. */
         int cflags = 0;
         if (flags & ZR_NO_CAUSTIC)
-            cflags = ZR_NO_CAUSTIC | (caustic_target(rs, h.part) ? ZR_CAUSTIC_LIGHT : 0);
+            cflags = ZR_NO_CAUSTIC | (specular_target_part(rs, h.part) ? ZR_CAUSTIC_LIGHT : 0);
         if (k_refl > 0) {
             int rflags = exact_direct | cflags;
             if ((flags & ZR_NO_GLINT) && !back && media_count == 0 && glint_sphere(rs, h.part))

@@ -39,7 +39,7 @@
 #include "render/prim.h"
 #include "util/r2.h"
 #include "util/vec3_convert.h"
-#include "zone/phase_one/caustic.h"
+#include "zone/phase_one/specular_targets.h"
 #include "zone/phase_two/media.h"
 #include "zone/zone.h"
 
@@ -270,7 +270,7 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
     int exact_direct = flags & ZR_EXACT_DIRECT;
     int cflags = 0;
     if (flags & ZR_NO_CAUSTIC)
-        cflags = ZR_NO_CAUSTIC | (caustic_target(rs, s->part) ? ZR_CAUSTIC_LIGHT : 0);
+        cflags = ZR_NO_CAUSTIC | (specular_target_part(rs, s->part) ? ZR_CAUSTIC_LIGHT : 0);
     /* Rays from here on are not the camera sample's: what they meet takes
      * one direction each of the sample's stretch, and exact direct light
      * at their ends is a point's own (no shared split). */
