@@ -374,9 +374,7 @@ static void print_scene(const render_job *job)
         fprintf(stderr, "note: %lld vertex normals of the models were not finite or "
                 "zero and were replaced by the faces' normals\n", info.replaced_normals);
     if (info.rough_materials)
-        fprintf(stderr, "note: %d model materials have a roughness, which is not read from "
-                "model files yet: their metal, mirror and glass lobes are smooth\n",
-                info.rough_materials);
+        fprintf(stderr, "rough model materials: %d (GGX lobes)\n", info.rough_materials);
     if (info.rough_lobes)
         fprintf(stderr, "rough materials: %d (GGX lobes)\n", info.rough_lobes);
     if (info.panes)

@@ -56,8 +56,8 @@ typedef struct zt_scene_info {
     long long skipped_triangles; /* degenerate ones the import left out */
     long long replaced_normals; /* vertex normals of a model that were not
                                    finite or zero, replaced from the faces */
-    int rough_materials; /* model files' materials whose roughness is not
-                            read yet (their lobes are smooth) */
+    int rough_materials; /* model files' materials with a rough (GGX) metallic
+                            or refractive lobe */
     int rough_lobes;  /* scene materials with a roughness above 0 and a
                          metallic, reflecting or refractive lobe (GGX) */
     int missing_textures; /* textures a model names but that are missing or

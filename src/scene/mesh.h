@@ -31,8 +31,8 @@ typedef struct mesh_slot {
                                triangles are area lights (and black otherwise,
                                like every light part) */
     int texture;            /* base-colour texture (index into textures), -1 */
-    double roughness;       /* from the file, 0 when absent; the material
-                               model has smooth lobes only: reported, unused */
+    double roughness;       /* the file's roughness factor (0 when absent),
+                               also mat.roughness */
     char name[64];          /* the file's material name, for messages */
 } mesh_slot;
 
@@ -55,7 +55,7 @@ typedef struct mesh {
     int skipped_degenerate; /* zero-area or repeated-vertex triangles */
     int replaced_normals;   /* vertex normals not finite or zero in the file,
                                replaced by the faces' normals */
-    int rough_slots;        /* slots whose roughness was ignored */
+    int rough_slots;        /* slots with a rough (GGX) lobe */
     int missing_textures;   /* textures named but missing or undecodable */
     char texture_problem[160]; /* the first such texture and why */
     char file[256];         /* the model file, as the scene names it */

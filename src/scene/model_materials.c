@@ -2,9 +2,9 @@
  *
  * glTF's metallic-roughness model and OBJ's MTL both reach us through
  * Assimp's material keys.  The mapping keeps what the material model can
- * show: base colour, metal, glass, emission.  glTF's thin dielectric
- * specular layer over non-metals (a 4% Fresnel reflection) and roughness
- * have no lobe here; roughness is counted so -v can say it was ignored. */
+ * show: base colour, metal, glass, roughness, emission.  glTF's thin
+ * dielectric specular layer over non-metals (a 4% Fresnel reflection) has
+ * no lobe here. */
 #define _POSIX_C_SOURCE 200809L
 #include "scene/model_materials.h"
 
@@ -279,8 +279,11 @@ static void map_material(const struct aiMaterial *am, int gltf, mesh_slot *s)
         if (isfinite(e.x) && isfinite(e.y) && isfinite(e.z))
             s->emission = e;
     }
+    /* glTF's roughness factor (default 1: a material that gives none is
+     * rough), onto the metallic and refractive lobes (diffuse has none). */
     if (get_float(am, AI_MATKEY_ROUGHNESS_FACTOR, &v))
         s->roughness = clamp01(v);
+    s->mat.roughness = s->roughness;
     s->texture = -1;
 }
 
@@ -320,7 +323,9 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
         map_material(sc->mMaterials[i], gltf, &m->slots[s]);
         m->slots[s].texture = material_texture(sc, sc->mMaterials[i], folder, m, names, &st,
                                                err, path);
-        if (m->slots[s].roughness > 0.0)
+        const material *mat = &m->slots[s].mat;
+        if (mat->roughness > 0.0 &&
+            (mat->weight[LOBE_METALLIC] > 0.0 || (mat->weight[LOBE_REFRACTIVE] > 0.0 && !mat->thin)))
             m->rough_slots++;
     }
     free(names);
