@@ -1,7 +1,46 @@
 /* Mesh triangles seen as parts, and shading normals and albedo at a hit. */
 #include "render/prim.h"
 
+#include "material/microfacet.h"
 #include "material/texture.h"
+
+static float channel(vec3f c, int k)
+{
+    return k == 0 ? c.x : k == 1 ? c.y : c.z;
+}
+
+/* m's material at texture coordinates (u, v) of its maps, into *out: the
+ * metallic weight and the rest (diffuse and refractive as the slot's
+ * transmission shares them), the GGX alpha, and the flags that follow. */
+static void material_at(const rs_object *m, float u, float v, rs_object *out)
+{
+    const rs_maps *mp = m->maps;
+    *out = *m;
+    if (mp->metal) {
+        float metal = mp->metallic * channel(texture_lookup_linear(mp->metal, u, v),
+                                             mp->metal_channel);
+        metal = metal > 0.0f ? (metal < 1.0f ? metal : 1.0f) : 0.0f;
+        out->weight[LOBE_METALLIC] = metal;
+        out->weight[LOBE_REFRACTIVE] = (1.0f - metal) * mp->transmission;
+        out->weight[LOBE_DIFFUSE] = (1.0f - metal) * (1.0f - mp->transmission);
+        out->weight[LOBE_REFLECTING] = 0.0f;
+        int lobes = 0;
+        for (int k = 0; k < LOBE_COUNT; k++)
+            lobes += out->weight[k] > 0.0f;
+        out->lobe_choice = lobes > 1;
+    }
+    if (mp->rough) {
+        float r = mp->roughness * channel(texture_lookup_linear(mp->rough, u, v),
+                                          mp->rough_channel);
+        out->alpha = r > 0.0f ? r * r : 0.0f;
+        if (out->alpha > 0.0f && out->alpha < GGX_ALPHA_MIN)
+            out->alpha = GGX_ALPHA_MIN;
+    }
+    out->rough = (uint8_t)(out->alpha > 0.0f &&
+                           (out->weight[LOBE_METALLIC] > 0.0f ||
+                            out->weight[LOBE_REFLECTING] > 0.0f ||
+                            (out->weight[LOBE_REFRACTIVE] > 0.0f && !out->thin)));
+}
 
 void rs_mesh_part(const rscene *rs, const rs_mesh *mm, int prim, rs_part *out)
 {
@@ -39,6 +78,7 @@ void rs_shade_at(const rscene *rs, int prim, const rs_part *p, const rs_object *
 {
     out->ns = n_facing;
     out->albedo = m->color;
+    out->m = NULL;
     if (prim < rs->part_count)
         return;
     const rs_mesh *mm = rs_mesh_of(rs, prim);
@@ -46,12 +86,18 @@ void rs_shade_at(const rscene *rs, int prim, const rs_part *p, const rs_object *
     float b1, b2;
     rs_triangle_barycentric(p, x, &b1, &b2);
     float b0 = 1.0f - b1 - b2;
-    if (m->texture && mm->m->uv) {
+    if ((m->texture || m->maps) && mm->m->uv) {
         const float *t0 = mm->m->uv + 2 * (size_t)v[0], *t1 = mm->m->uv + 2 * (size_t)v[1];
         const float *t2 = mm->m->uv + 2 * (size_t)v[2];
         float u = b0 * t0[0] + b1 * t1[0] + b2 * t2[0];
         float w = b0 * t0[1] + b1 * t1[1] + b2 * t2[1];
-        out->albedo = f3_mul(m->color, texture_lookup(m->texture, u, w));
+        if (m->texture)
+            out->albedo = f3_mul(m->color, texture_lookup(m->texture, u, w));
+        if (m->maps) {
+            material_at(m, u, w, &out->mat);
+            out->mat.color = out->albedo;
+            out->m = &out->mat;
+        }
     }
     if (!mm->smooth)
         return;
