@@ -1,6 +1,8 @@
 /* Mesh triangles seen as parts, and shading normals and albedo at a hit. */
 #include "render/prim.h"
 
+#include <math.h>
+
 #include "material/microfacet.h"
 #include "material/texture.h"
 
@@ -73,6 +75,72 @@ void rs_mesh_part(const rscene *rs, const rs_mesh *mm, int prim, rs_part *out)
     }
 }
 
+/* The tangent at barycentric (b0, b1, b2) of the triangle with vertices v
+ * (not unit) and the bitangent's side: from the mesh's vertex tangents,
+ * else from the triangle's texture coordinates (the direction of growing
+ * u, the side that of growing v).  0 when there is none. */
+static int tangent_at(const rs_mesh *mm, const rs_part *p, const uint32_t *v, float b0, float b1,
+                      float b2, vec3f n, vec3f *t, float *side)
+{
+    const float *tg = mm->m->tangent;
+    if (tg) {
+        const float *t0 = tg + 4 * (size_t)v[0], *t1 = tg + 4 * (size_t)v[1];
+        const float *t2 = tg + 4 * (size_t)v[2];
+        if (t0[3] != 0.0f && t1[3] != 0.0f && t2[3] != 0.0f) {
+            *t = f3_add(f3_add(f3_scale(f3(t0[0], t0[1], t0[2]), b0),
+                               f3_scale(f3(t1[0], t1[1], t1[2]), b1)),
+                        f3_scale(f3(t2[0], t2[1], t2[2]), b2));
+            *side = t0[3] + t1[3] + t2[3] < 0.0f ? -1.0f : 1.0f;
+            return 1;
+        }
+    }
+    const float *uv = mm->m->uv;
+    const float *w0 = uv + 2 * (size_t)v[0], *w1 = uv + 2 * (size_t)v[1];
+    const float *w2 = uv + 2 * (size_t)v[2];
+    float du1 = w1[0] - w0[0], dv1 = w1[1] - w0[1], du2 = w2[0] - w0[0], dv2 = w2[1] - w0[1];
+    float det = du1 * dv2 - du2 * dv1;
+    if (!(det != 0.0f) || !isfinite(det))
+        return 0;
+    float r = 1.0f / det;
+    *t = f3_scale(f3_sub(f3_scale(p->e1, dv2), f3_scale(p->e2, dv1)), r);
+    vec3f bt = f3_scale(f3_sub(f3_scale(p->e2, du1), f3_scale(p->e1, du2)), r);
+    *side = f3_dot(f3_cross(n, *t), bt) < 0.0f ? -1.0f : 1.0f;
+    return 1;
+}
+
+/* ns (unit, facing the ray; back: seen from behind the front face) bent
+ * by the tangent-space normal map at the hit: n' = normalize(x s t + y s b
+ * + z n), (x, y, z) the texel times 2 minus 1, s the map's scale, t the
+ * tangent made orthogonal to the front normal n, b = side (n x t), as glTF
+ * defines it.  ns itself where the frame or the texel gives no direction. */
+static vec3f normal_mapped(const rs_mesh *mm, const rs_part *p, const uint32_t *v, float b0,
+                           float b1, float b2, const rs_maps *mp, vec3f ns, int back)
+{
+    vec3f n = back ? f3_neg(ns) : ns;
+    vec3f t;
+    float side;
+    if (!tangent_at(mm, p, v, b0, b1, b2, n, &t, &side))
+        return ns;
+    t = f3_sub(t, f3_scale(n, f3_dot(n, t)));
+    float tl = f3_length(t);
+    if (!(tl > 0.0f) || !isfinite(tl))
+        return ns;
+    t = f3_scale(t, 1.0f / tl);
+    vec3f b = f3_scale(f3_cross(n, t), side);
+    const float *uv = mm->m->uv;
+    float u = b0 * uv[2 * v[0]] + b1 * uv[2 * v[1]] + b2 * uv[2 * v[2]];
+    float w = b0 * uv[2 * v[0] + 1] + b1 * uv[2 * v[1] + 1] + b2 * uv[2 * v[2] + 1];
+    vec3f c = texture_lookup_linear(mp->normal, u, w);
+    float x = (2.0f * c.x - 1.0f) * mp->normal_scale, y = (2.0f * c.y - 1.0f) * mp->normal_scale;
+    float z = 2.0f * c.z - 1.0f;
+    vec3f d = f3_add(f3_add(f3_scale(t, x), f3_scale(b, y)), f3_scale(n, z));
+    float len = f3_length(d);
+    if (!(len > 0.0f) || !isfinite(len))
+        return ns;
+    d = f3_scale(d, 1.0f / len);
+    return back ? f3_neg(d) : d;
+}
+
 void rs_shade_at(const rscene *rs, int prim, const rs_part *p, const rs_object *m, vec3f x,
                  vec3f n_facing, rs_shade *out)
 {
@@ -99,23 +167,32 @@ void rs_shade_at(const rscene *rs, int prim, const rs_part *p, const rs_object *
             out->m = &out->mat;
         }
     }
-    if (!mm->smooth)
+    int mapped = m->maps && m->maps->normal && mm->m->uv;
+    if (!mm->smooth && !mapped)
         return;
-    const float *nrm = mm->m->normal;
-    vec3f n0 = f3(nrm[3 * v[0]], nrm[3 * v[0] + 1], nrm[3 * v[0] + 2]);
-    vec3f n1 = f3(nrm[3 * v[1]], nrm[3 * v[1] + 1], nrm[3 * v[1] + 2]);
-    vec3f n2 = f3(nrm[3 * v[2]], nrm[3 * v[2] + 1], nrm[3 * v[2] + 2]);
-    vec3f ns = f3_add(f3_add(f3_scale(n0, b0), f3_scale(n1, b1)), f3_scale(n2, b2));
-    /* The vertex normals belong to the front face: seen from behind, they
-     * turn with the geometric normal. */
-    if (f3_dot(p->n, n_facing) < 0.0f)
-        ns = f3_neg(ns);
-    float len = f3_length(ns);
-    if (!(len > 0.0f))
-        return;
-    ns = f3_scale(ns, 1.0f / len);
+    /* Seen from behind, the front face's normals turn with the geometric
+     * normal. */
+    int back = f3_dot(p->n, n_facing) < 0.0f;
+    vec3f ns = n_facing;
+    if (mm->smooth) {
+        const float *nrm = mm->m->normal;
+        vec3f n0 = f3(nrm[3 * v[0]], nrm[3 * v[0] + 1], nrm[3 * v[0] + 2]);
+        vec3f n1 = f3(nrm[3 * v[1]], nrm[3 * v[1] + 1], nrm[3 * v[1] + 2]);
+        vec3f n2 = f3(nrm[3 * v[2]], nrm[3 * v[2] + 1], nrm[3 * v[2] + 2]);
+        vec3f ni = f3_add(f3_add(f3_scale(n0, b0), f3_scale(n1, b1)), f3_scale(n2, b2));
+        if (back)
+            ni = f3_neg(ni);
+        float len = f3_length(ni);
+        if (len > 0.0f)
+            ns = f3_scale(ni, 1.0f / len);
+        else if (!mapped)
+            return;
+    }
+    if (mapped)
+        ns = normal_mapped(mm, p, v, b0, b1, b2, m->maps, ns, back);
     /* A normal bent to or beyond the geometric horizon (a coarse mesh's
-     * silhouette) is lifted to a small angle above it. */
+     * silhouette, a steep normal map) is lifted to a small angle above
+     * it. */
     float c = f3_dot(ns, n_facing);
     const float min_c = 0.01f;
     if (c < min_c) {
