@@ -237,7 +237,7 @@ static int material_texture(model_textures *tx, const struct aiMaterial *am, zt_
 }
 
 /* One material of the file as a slot. */
-static void map_material(const struct aiMaterial *am, int gltf, mesh_slot *s)
+static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_slot *s)
 {
     memset(s, 0, sizeof *s);
     struct aiString name;
@@ -293,16 +293,21 @@ static void map_material(const struct aiMaterial *am, int gltf, mesh_slot *s)
      * rough), onto the metallic and refractive lobes (diffuse has none). */
     if (get_float(am, AI_MATKEY_ROUGHNESS_FACTOR, &v))
         s->roughness = clamp01(v);
+    /* MTL without Pr: the Phong exponent Ns.  Beckmann's alpha for a Phong
+     * lobe of exponent n is sqrt(2 / (n + 2)) (Walter et al. 2007), GGX's
+     * alpha is taken equal to it, and alpha = roughness^2. */
+    else if (obj && get_float(am, AI_MATKEY_SHININESS, &v) && v >= 0.0)
+        s->roughness = clamp01(pow(2.0 / (v + 2.0), 0.25));
     s->mat.roughness = s->roughness;
     s->texture = -1;
     s->rough_map.texture = s->metal_map.texture = s->normal_texture = -1;
     s->normal_scale = 1.0;
 }
 
-static int is_gltf(const char *path)
+static int has_extension(const char *path, const char *a, const char *b)
 {
     const char *dot = strrchr(path, '.');
-    return dot && (strcasecmp(dot, ".gltf") == 0 || strcasecmp(dot, ".glb") == 0);
+    return dot && (strcasecmp(dot, a) == 0 || (b && strcasecmp(dot, b) == 0));
 }
 
 zt_status model_materials(const struct aiScene *sc, const char *path,
@@ -330,14 +335,14 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
     }
     char folder[4096];
     folder_of(path, folder, sizeof folder);
-    int gltf = is_gltf(path);
+    int gltf = has_extension(path, ".gltf", ".glb"), obj = has_extension(path, ".obj", NULL);
     model_textures tx = {sc, folder, path, m, names, (int)capacity};
     zt_status st = ZT_OK;
     for (unsigned i = 0; i < sc->mNumMaterials && st == ZT_OK; i++) {
         int s = slot_of_material[i];
         if (s < 0 || s >= slot_count || !sc->mMaterials[i])
             continue;
-        map_material(sc->mMaterials[i], gltf, &m->slots[s]);
+        map_material(sc->mMaterials[i], gltf, obj, &m->slots[s]);
         m->slots[s].texture = material_texture(&tx, sc->mMaterials[i], &st, err);
         if (st == ZT_OK)
             st = model_maps(&tx, sc->mMaterials[i], gltf, &m->slots[s], err);
