@@ -63,6 +63,13 @@ typedef struct zt_scene_info {
     int missing_textures; /* textures a model names but that are missing or
                              cannot be decoded (left out: base colour only) */
     char texture_problem[160]; /* the first of them and why */
+    int map_fallbacks; /* models' normal, roughness and metal maps left out
+                          (cannot be decoded, or not the base texture's
+                          size): the factors alone, the interpolated normal */
+    char map_problem[160]; /* the first of them and why */
+    char unused[256]; /* what the models' materials have that is not used,
+                         counted by kind ("2 emissive textures, 1 sheen
+                         layers"); empty when nothing */
     int has_sky;      /* non-zero when a sky colour is given */
     int panes;        /* materials (of things and of models' slots) whose
                          refractive lobe is a thin pane */
