@@ -4,7 +4,7 @@ Python (json, struct, zlib): a test model for model files' materials.
 
     python3 tools/make_pbr_gltf.py OUT.gltf [--rough R] [--metal M] [--tilt DEG] [--scale S]
                                    [--size N] [--tangents] [--base-size N] [--color R G B]
-                                   [--no-normal] [--no-mr]
+                                   [--no-normal] [--no-mr] [--metal-right M]
 
 The model is one square of side 2 in the plane y = 0, centred on the origin, its front face (and
 normal) up, +x along the texture's u and -z along its v (so the image's left half is x < 0 and
@@ -14,7 +14,8 @@ The textures are N x N texels (--size, default 4), in halves along u:
 
   metallic-roughness (linear, glTF's channels: G roughness, B metallic)
       left half   G = round(255 R), B = round(255 M)      (--rough, default 1; --metal, default 1)
-      right half  G = 0,            B = round(255 M)      (a smooth metal beside a rough one)
+      right half  G = 0,            B = round(255 M)      (a smooth metal beside a rough one;
+                                                          --metal-right sets the right half's M)
   normal (linear, tangent space: x along +u, y along +v, z out of the surface)
       left half   the normal tilted by DEG degrees toward +u (--tilt, default 0):
                   (sin, 0, cos) coded as round(255 (c + 1) / 2)
@@ -67,8 +68,8 @@ def main(argv):
     try:
         while i < len(argv):
             a = argv[i]
-            if a in ("--rough", "--metal", "--tilt", "--scale"):
-                args[a[2:]] = float(argv[i + 1])
+            if a in ("--rough", "--metal", "--tilt", "--scale", "--metal-right"):
+                args[a[2:].replace("-", "_")] = float(argv[i + 1])
                 i += 2
             elif a in ("--size", "--base-size"):
                 args[a[2:].replace("-", "_")] = int(argv[i + 1])
@@ -97,8 +98,9 @@ def main(argv):
     n = args["size"]
     r = max(0, min(255, int(round(255 * args["rough"]))))
     m = max(0, min(255, int(round(255 * args["metal"]))))
+    mr = max(0, min(255, int(round(255 * args.get("metal_right", args["metal"])))))
     if args["mr"]:
-        png(os.path.join(folder, stem + "_mr.png"), n, n, halves(n, (0, r, m), (0, 0, m)))
+        png(os.path.join(folder, stem + "_mr.png"), n, n, halves(n, (0, r, m), (0, 0, mr)))
     t = math.radians(args["tilt"])
     if args["normal"]:
         png(os.path.join(folder, stem + "_n.png"), n, n,

@@ -75,6 +75,23 @@ void rs_mesh_part(const rscene *rs, const rs_mesh *mm, int prim, rs_part *out)
     }
 }
 
+float rs_maps_diffuse_mean(const rs_object *m, const float *uv0, const float *uv1,
+                           const float *uv2, int n)
+{
+    float sum = 0.0f;
+    int count = 0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; i + j < n; j++) {
+            float b1 = (i + 1.0f / 3.0f) / n, b2 = (j + 1.0f / 3.0f) / n, b0 = 1.0f - b1 - b2;
+            rs_object at;
+            material_at(m, b0 * uv0[0] + b1 * uv1[0] + b2 * uv2[0],
+                        b0 * uv0[1] + b1 * uv1[1] + b2 * uv2[1], &at);
+            sum += at.weight[LOBE_DIFFUSE];
+            count++;
+        }
+    return count ? sum / (float)count : m->weight[LOBE_DIFFUSE];
+}
+
 /* The tangent at barycentric (b0, b1, b2) of the triangle with vertices v
  * (not unit) and the bitangent's side: from the mesh's vertex tangents,
  * else from the triangle's texture coordinates (the direction of growing

@@ -98,6 +98,12 @@ static inline int rs_needs_shade(const rscene *rs, int prim, const rs_object *m)
            (prim >= rs->part_count && rs_mesh_of(rs, prim)->smooth);
 }
 
+/* The mean diffuse weight of m (which has a metal map) over the triangle
+ * of texture coordinates uv0, uv1, uv2, on texture_triangle_mean's
+ * lattice of n (n + 1) / 2 points. */
+float rs_maps_diffuse_mean(const rs_object *m, const float *uv0, const float *uv1,
+                           const float *uv2, int n);
+
 /* The material at the hit that sh describes, m being the object's. */
 static inline const rs_object *rs_shade_material(const rs_shade *sh, const rs_object *m)
 {
