@@ -73,7 +73,10 @@ uint64_t scene_hash(const zt_scene *sc)
                 fnv_i32(&h, sl->mat.thin);
                 fnv_v3(&h, sl->mat.tint);
             }
-            if (sl->mat.roughness > 0)
+            /* (A roughness on a diffuse-only slot shapes nothing: glTF
+             * gives every material one, and forests of such models saved
+             * before roughness was read stay valid.) */
+            if (sl->mat.roughness > 0 && sl->mat.weight[LOBE_DIFFUSE] < 1)
                 fnv_f64(&h, sl->mat.roughness);
             fnv_v3(&h, sl->emission);
             fnv_i32(&h, sl->texture);
