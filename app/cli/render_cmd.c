@@ -374,9 +374,7 @@ static void print_scene(const render_job *job)
         fprintf(stderr, "note: %lld vertex normals of the models were not finite or "
                 "zero and were replaced by the faces' normals\n", info.replaced_normals);
     if (info.rough_materials)
-        fprintf(stderr, "note: %d model materials have a roughness, which is not read from "
-                "model files yet: their metal, mirror and glass lobes are smooth\n",
-                info.rough_materials);
+        fprintf(stderr, "rough model materials: %d (GGX lobes)\n", info.rough_materials);
     if (info.rough_lobes)
         fprintf(stderr, "rough materials: %d (GGX lobes)\n", info.rough_lobes);
     if (info.panes)
@@ -385,6 +383,12 @@ static void print_scene(const render_job *job)
     if (info.missing_textures)
         fprintf(stderr, "note: %d model textures are missing or unreadable and were left "
                 "out (%s)\n", info.missing_textures, info.texture_problem);
+    if (info.map_fallbacks)
+        fprintf(stderr, "note: %d model normal, roughness or metal maps were left out, the "
+                "materials' factors and the interpolated normals taking their place (%s)\n",
+                info.map_fallbacks, info.map_problem);
+    if (info.unused[0])
+        fprintf(stderr, "note: model materials have what is not used yet: %s\n", info.unused);
     fprintf(stderr, "method %s, depth %d, level %s%d\n",
             o->method == ZT_METHOD_PATH ? "path" : "zone", o->depth,
             o->level < 0 ? "all up to " : "", o->level < 0 ? o->depth : o->level);

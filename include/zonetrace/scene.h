@@ -56,13 +56,20 @@ typedef struct zt_scene_info {
     long long skipped_triangles; /* degenerate ones the import left out */
     long long replaced_normals; /* vertex normals of a model that were not
                                    finite or zero, replaced from the faces */
-    int rough_materials; /* model files' materials whose roughness is not
-                            read yet (their lobes are smooth) */
+    int rough_materials; /* model files' materials with a rough (GGX) metallic
+                            or refractive lobe */
     int rough_lobes;  /* scene materials with a roughness above 0 and a
                          metallic, reflecting or refractive lobe (GGX) */
     int missing_textures; /* textures a model names but that are missing or
                              cannot be decoded (left out: base colour only) */
     char texture_problem[160]; /* the first of them and why */
+    int map_fallbacks; /* models' normal, roughness and metal maps left out
+                          (missing or cannot be decoded): the factors
+                          alone, the interpolated normal */
+    char map_problem[160]; /* the first of them and why */
+    char unused[256]; /* what the models' materials have that is not used,
+                         counted by kind ("2 emissive textures, 1 sheen
+                         layers"); empty when nothing */
     int has_sky;      /* non-zero when a sky colour is given */
     int panes;        /* materials (of things and of models' slots) whose
                          refractive lobe is a thin pane */

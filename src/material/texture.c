@@ -60,17 +60,19 @@ static inline int wrap_index(int i, int n, int repeat)
     return i < 0 ? 0 : (i >= n ? n - 1 : i);
 }
 
-static inline vec3f texel(const mesh_texture *t, int i, int j)
+static inline vec3f texel(const mesh_texture *t, int i, int j, int linear)
 {
     const unsigned char *p = t->rgba + 4 * ((size_t)j * (size_t)t->width + (size_t)i);
+    if (linear)
+        return f3_scale(f3(p[0], p[1], p[2]), 1.0f / 255.0f);
     return f3(texture_srgb_to_linear[p[0]], texture_srgb_to_linear[p[1]],
               texture_srgb_to_linear[p[2]]);
 }
 
-vec3f texture_lookup(const mesh_texture *t, float u, float v)
+static inline vec3f lookup(const mesh_texture *t, float u, float v, int linear)
 {
     if (!isfinite(u) || !isfinite(v))
-        return texel(t, 0, 0);
+        return texel(t, 0, 0, linear);
     /* Texel coordinates with centres at integers; v = 1 is row 0. */
     double x = (double)u * t->width - 0.5, y = (1.0 - (double)v) * t->height - 0.5;
     /* Far coordinates are brought near first, so the ints cannot overflow. */
@@ -85,9 +87,21 @@ vec3f texture_lookup(const mesh_texture *t, float u, float v)
     float ax = (float)(x - fx), ay = (float)(y - fy);
     int i0 = wrap_index((int)fx, t->width, t->wrap), i1 = wrap_index((int)fx + 1, t->width, t->wrap);
     int j0 = wrap_index((int)fy, t->height, t->wrap), j1 = wrap_index((int)fy + 1, t->height, t->wrap);
-    vec3f top = f3_add(f3_scale(texel(t, i0, j0), 1.0f - ax), f3_scale(texel(t, i1, j0), ax));
-    vec3f bot = f3_add(f3_scale(texel(t, i0, j1), 1.0f - ax), f3_scale(texel(t, i1, j1), ax));
+    vec3f top = f3_add(f3_scale(texel(t, i0, j0, linear), 1.0f - ax),
+                       f3_scale(texel(t, i1, j0, linear), ax));
+    vec3f bot = f3_add(f3_scale(texel(t, i0, j1, linear), 1.0f - ax),
+                       f3_scale(texel(t, i1, j1, linear), ax));
     return f3_add(f3_scale(top, 1.0f - ay), f3_scale(bot, ay));
+}
+
+vec3f texture_lookup(const mesh_texture *t, float u, float v)
+{
+    return lookup(t, u, v, 0);
+}
+
+vec3f texture_lookup_linear(const mesh_texture *t, float u, float v)
+{
+    return lookup(t, u, v, 1);
 }
 
 vec3f texture_triangle_mean(const mesh_texture *t, const float *uv0, const float *uv1,

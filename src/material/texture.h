@@ -1,4 +1,4 @@
-/* Base-colour textures as the renderers read them: bilinear between texel
+/* Textures as the renderers read them: bilinear between texel
  * centres, in linear light (texels are stored as 8-bit sRGB). */
 #ifndef ZT_MATERIAL_TEXTURE_H
 #define ZT_MATERIAL_TEXTURE_H
@@ -16,6 +16,10 @@ extern const float texture_srgb_to_linear[256];
  * the texture (wrap) or holds the edge texels (clamp).  Non-finite
  * coordinates read texel (0, 0). */
 vec3f texture_lookup(const mesh_texture *t, float u, float v);
+
+/* The same for a texture of data (roughness, metalness, normals): the
+ * texels' codes c read as c / 255, without the sRGB curve. */
+vec3f texture_lookup_linear(const mesh_texture *t, float u, float v);
 
 /* The mean linear colour of the texture over the triangle of texture
  * coordinates uv0, uv1, uv2 (2 floats each), estimated on a fixed lattice

@@ -155,7 +155,8 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
         vec3f wo = f3_neg(d);
         /* Meshes: the shading normal ns (the geometric n still decides
-         * sides) and a textured albedo, in a copy of the material. */
+         * sides) and a textured albedo, in a copy of the material (with
+         * maps, the material at the hit). */
         vec3f ns = n;
         int bent = 0;
         rs_object textured;
@@ -164,8 +165,8 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             rs_shade_at(rs, h.part, p, m, x, n, &sh);
             ns = sh.ns;
             bent = ns.x != n.x || ns.y != n.y || ns.z != n.z;
-            if (m->texture) {
-                textured = *m;
+            if (m->texture || sh.m) {
+                textured = *rs_shade_material(&sh, m);
                 textured.color = sh.albedo;
                 m = &textured;
             }

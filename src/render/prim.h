@@ -71,10 +71,15 @@ static inline void rs_triangle_barycentric(const rs_part *p, vec3f x, float *b1,
 
 /* What shading takes from a hit besides the rs_part: the shading normal
  * (unit, on the side of the geometric normal n_facing, which faces the
- * incoming ray) and the albedo (the object's colour, times its texture). */
+ * incoming ray), the albedo (the object's colour, times its texture) and,
+ * for an object with maps (rs_object.maps), the material at the hit. */
 typedef struct rs_shade {
     vec3f ns;
     vec3f albedo;
+    const rs_object *m; /* &mat when the maps gave it, else NULL: the
+                           object's own (rs_shade_material) */
+    rs_object mat;      /* the object's with the maps' weights, alpha and
+                           rough at the hit, and color = albedo */
 } rs_shade;
 
 /* For a hit at x on primitive prim (view p, object m) whose geometric
@@ -84,12 +89,25 @@ typedef struct rs_shade {
 void rs_shade_at(const rscene *rs, int prim, const rs_part *p, const rs_object *m, vec3f x,
                  vec3f n_facing, rs_shade *out);
 
-/* Whether the hit needs rs_shade_at at all (a textured object or a smooth
- * mesh); when not, ns = n_facing and albedo = m->color. */
+/* Whether the hit needs rs_shade_at at all (a textured object, one with
+ * maps, or a smooth mesh); when not, ns = n_facing, albedo = m->color and
+ * the material is m. */
 static inline int rs_needs_shade(const rscene *rs, int prim, const rs_object *m)
 {
-    return m->texture != NULL ||
+    return m->texture != NULL || m->maps != NULL ||
            (prim >= rs->part_count && rs_mesh_of(rs, prim)->smooth);
+}
+
+/* The mean diffuse weight of m (which has a metal map) over the triangle
+ * of texture coordinates uv0, uv1, uv2, on texture_triangle_mean's
+ * lattice of n (n + 1) / 2 points. */
+float rs_maps_diffuse_mean(const rs_object *m, const float *uv0, const float *uv1,
+                           const float *uv2, int n);
+
+/* The material at the hit that sh describes, m being the object's. */
+static inline const rs_object *rs_shade_material(const rs_shade *sh, const rs_object *m)
+{
+    return sh->m ? sh->m : m;
 }
 
 #endif

@@ -89,6 +89,26 @@ static int build_meshes(rscene *rs, const zt_scene *scene, const int *lights_off
             fill_object(ro, &sl->mat, sl->emission, !v3_is_black(sl->emission), o);
             if (sl->texture >= 0 && !ro->is_light && m->uv)
                 ro->texture = &m->textures[sl->texture];
+            if (!ro->is_light && m->uv &&
+                (sl->rough_map.texture >= 0 || sl->metal_map.texture >= 0 ||
+                 sl->normal_texture >= 0)) {
+                rs_maps *mp = &rs->maps[ro - rs->objects];
+                if (sl->rough_map.texture >= 0) {
+                    mp->rough = &m->textures[sl->rough_map.texture];
+                    mp->rough_channel = sl->rough_map.channel;
+                }
+                if (sl->metal_map.texture >= 0) {
+                    mp->metal = &m->textures[sl->metal_map.texture];
+                    mp->metal_channel = sl->metal_map.channel;
+                }
+                if (sl->normal_texture >= 0)
+                    mp->normal = &m->textures[sl->normal_texture];
+                mp->roughness = (float)sl->roughness;
+                mp->metallic = (float)sl->metallic;
+                mp->transmission = (float)sl->transmission;
+                mp->normal_scale = (float)sl->normal_scale;
+                ro->maps = mp;
+            }
         }
     }
     rs->prim_count = prims;
@@ -175,13 +195,14 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
     rs->part_count = scene->part_count;
     rs->parts = calloc((size_t)(scene->part_count + 1), sizeof(rs_part));
     rs->objects = calloc((size_t)(scene->object_count + slots + 1), sizeof(rs_object));
+    rs->maps = calloc((size_t)(scene->object_count + slots + 1), sizeof(rs_maps));
     rs->lights = calloc((size_t)(scene->part_count + mesh_lights + 1), sizeof(rs_light));
     rs->point_lights = calloc((size_t)(scene->part_count + 1), sizeof(int));
     rs->meshes = calloc((size_t)(scene->mesh_count + 1), sizeof(rs_mesh));
     int planes_ok = 1;
     for (int l = 0; l < 2; l++)
         planes_ok &= planes_alloc(&rs->planes[l], scene, l);
-    if (!rs->parts || !rs->objects || !rs->lights || !rs->point_lights || !rs->meshes ||
+    if (!rs->parts || !rs->objects || !rs->maps || !rs->lights || !rs->point_lights || !rs->meshes ||
         !planes_ok) {
         rscene_free(rs);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
@@ -268,6 +289,7 @@ void rscene_free(rscene *rs)
     accel_free(rs->accel);
     free(rs->parts);
     free(rs->objects);
+    free(rs->maps);
     free(rs->lights);
     free(rs->point_lights);
     free(rs->meshes);

@@ -33,6 +33,18 @@ typedef struct rs_part {
                            it (0: not sampled) */
 } rs_part;
 
+/* A model material's maps, read at each hit (render/prim.c): the
+ * roughness is `roughness` times channel rough_channel of `rough`, the
+ * metallic weight `metallic` times channel metal_channel of `metal` (the
+ * rest of the weight then diffuse and refractive by `transmission`), the
+ * shading normal bent by the tangent-space `normal` map with its x and y
+ * times normal_scale.  A NULL texture: that map is absent. */
+typedef struct rs_maps {
+    const struct mesh_texture *rough, *metal, *normal;
+    int rough_channel, metal_channel;
+    float roughness, metallic, transmission, normal_scale;
+} rs_maps;
+
 typedef struct rs_object {
     float weight[LOBE_COUNT];
     vec3f color;
@@ -50,6 +62,11 @@ typedef struct rs_object {
     float alpha;        /* GGX alpha = roughness^2 (0: smooth lobes) */
     vec3f tint;         /* a pane's transmission colour */
     const struct mesh_texture *texture; /* base colour, times color; NULL */
+    const rs_maps *maps; /* a model material's maps (NULL: none): weight,
+                            alpha and rough are then what the maps give
+                            somewhere (weights their mean, alpha the
+                            largest), and rs_shade_at gives the material
+                            at a hit */
 } rs_object;
 
 /* A mesh of the scene model as the renderers see it: its arrays are the
@@ -112,6 +129,7 @@ typedef struct rscene {
     int mesh_count;
     int prim_count;     /* parts and mesh triangles */
     rs_object *objects; /* the scene model's objects, then the meshes' slots */
+    rs_maps *maps;      /* objects' maps, by object (most unused) */
     int object_count;
     rs_light *lights;   /* parts sampled by next-event estimation */
     int light_count;

@@ -46,6 +46,7 @@ static void free_arrays(mesh *m)
     free(m->position);
     free(m->normal);
     free(m->uv);
+    free(m->tangent);
     free(m->index);
     free(m->slot);
     free(m->slots);
@@ -88,6 +89,7 @@ mesh *mesh_copy(const mesh *m)
     c->position = dup_bytes(m->position, (3 * v + 1) * sizeof(float), &ok);
     c->normal = dup_bytes(m->normal, (3 * v + 1) * sizeof(float), &ok);
     c->uv = dup_bytes(m->uv, (2 * v + 1) * sizeof(float), &ok);
+    c->tangent = dup_bytes(m->tangent, (4 * v + 1) * sizeof(float), &ok);
     c->index = dup_bytes(m->index, (3 * t + 1) * sizeof(uint32_t), &ok);
     c->slot = dup_bytes(m->slot, (t + 1) * sizeof(uint16_t), &ok);
     c->slots = dup_bytes(m->slots, (size_t)m->slot_count * sizeof(mesh_slot), &ok);
@@ -164,6 +166,26 @@ void mesh_transform(mesh *m, const double a[9], const double t[3])
             }
         }
     }
+    /* Tangents go with the positions; a mirror turns the bitangent's side
+     * (the normal is mapped by the inverse transpose, the tangent by a). */
+    if (m->tangent)
+        for (int v = 0; v < m->vertex_count; v++) {
+            float *q = m->tangent + 4 * (size_t)v;
+            double x = q[0], y = q[1], z = q[2];
+            double tx = a[0] * x + a[1] * y + a[2] * z;
+            double ty = a[3] * x + a[4] * y + a[5] * z;
+            double tz = a[6] * x + a[7] * y + a[8] * z;
+            double l = sqrt(tx * tx + ty * ty + tz * tz);
+            if (l > 0 && isfinite(l)) {
+                q[0] = (float)(tx / l);
+                q[1] = (float)(ty / l);
+                q[2] = (float)(tz / l);
+                if (det < 0)
+                    q[3] = -q[3];
+            } else {
+                q[3] = 0.0f;
+            }
+        }
     /* A mirror turns the winding: swap two corners so the front stays on
      * the normals' side. */
     if (det < 0)
@@ -195,10 +217,28 @@ uint64_t mesh_memory(const mesh *m)
         b += (3 * v + 1) * sizeof(float);
     if (m->uv)
         b += (2 * v + 1) * sizeof(float);
+    if (m->tangent)
+        b += (4 * v + 1) * sizeof(float);
     if (m->slot)
         b += (t + 1) * sizeof(uint16_t);
     b += (uint64_t)m->slot_count * sizeof(mesh_slot);
     for (int i = 0; i < m->texture_count; i++)
         b += (uint64_t)m->textures[i].width * m->textures[i].height * 4;
     return b;
+}
+
+const char *mesh_unused_name(int k)
+{
+    static const char *const names[MESH_UNUSED_COUNT] = {
+        "emissive textures",
+        "occlusion textures",
+        "alpha masks (alphaMode MASK)",
+        "alpha blends (alphaMode BLEND)",
+        "specular layers or textures",
+        "clearcoat layers",
+        "sheen layers",
+        "bump (height) maps",
+        "other textures",
+    };
+    return k >= 0 && k < MESH_UNUSED_COUNT ? names[k] : "?";
 }

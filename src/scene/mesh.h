@@ -23,6 +23,32 @@ typedef struct mesh_texture {
     int wrap;               /* 1 repeat (the default), 0 clamp to the edge */
 } mesh_texture;
 
+/* A scalar map of a slot: the value at a hit is `factor` times channel
+ * `channel` (0 R, 1 G, 2 B) of texture `texture` read linearly (these are
+ * data, not colours); texture -1: none (the value is the factor). */
+typedef struct mesh_map {
+    int texture;
+    int channel;
+} mesh_map;
+
+/* What a model's materials may have that the renderers do not use, counted
+ * for -v (mesh_unused_name gives the words). */
+enum {
+    MESH_UNUSED_EMISSIVE_TEXTURE,
+    MESH_UNUSED_OCCLUSION,
+    MESH_UNUSED_ALPHA_MASK,
+    MESH_UNUSED_ALPHA_BLEND,
+    MESH_UNUSED_SPECULAR,
+    MESH_UNUSED_CLEARCOAT,
+    MESH_UNUSED_SHEEN,
+    MESH_UNUSED_BUMP,
+    MESH_UNUSED_OTHER_TEXTURE,
+    MESH_UNUSED_COUNT
+};
+
+/* "emissive textures", "alpha masks", ... (plural, for "N <name>"). */
+const char *mesh_unused_name(int k);
+
 /* One material of a mesh ("slot"): every triangle names one. */
 typedef struct mesh_slot {
     material mat;           /* the four-weight material; colour is the base
@@ -31,8 +57,15 @@ typedef struct mesh_slot {
                                triangles are area lights (and black otherwise,
                                like every light part) */
     int texture;            /* base-colour texture (index into textures), -1 */
-    double roughness;       /* from the file, 0 when absent; the material
-                               model has smooth lobes only: reported, unused */
+    double roughness;       /* the file's roughness factor (0 when absent),
+                               also mat.roughness */
+    double metallic;        /* the metallic factor (mat's metallic weight
+                               when there is no metal map) */
+    double transmission;    /* the non-metallic part's refractive share */
+    mesh_map rough_map;     /* roughness at a hit: roughness x the map */
+    mesh_map metal_map;     /* metallic at a hit: metallic x the map */
+    int normal_texture;     /* tangent-space normal map, -1 */
+    double normal_scale;    /* its x and y scale (glTF's normalTexture.scale) */
     char name[64];          /* the file's material name, for messages */
 } mesh_slot;
 
@@ -44,6 +77,10 @@ typedef struct mesh {
     float *position;
     float *normal;          /* 3 per vertex, unit; NULL: flat shading */
     float *uv;              /* 2 per vertex; NULL: no texture coordinates */
+    float *tangent;         /* 4 per vertex: the direction of growing u
+                               (unit), then w = +-1, the bitangent being
+                               w (normal x tangent); w = 0: none for that
+                               vertex.  NULL unless a slot has a normal map */
     uint32_t *index;        /* 3 per triangle; the front face is counter-
                                clockwise, as for "triangle" parts */
     uint16_t *slot;         /* per triangle; NULL when slot_count == 1 */
@@ -55,9 +92,13 @@ typedef struct mesh {
     int skipped_degenerate; /* zero-area or repeated-vertex triangles */
     int replaced_normals;   /* vertex normals not finite or zero in the file,
                                replaced by the faces' normals */
-    int rough_slots;        /* slots whose roughness was ignored */
+    int rough_slots;        /* slots with a rough (GGX) lobe */
     int missing_textures;   /* textures named but missing or undecodable */
     char texture_problem[160]; /* the first such texture and why */
+    int map_fallbacks;      /* normal, roughness or metal maps left out
+                               (missing or undecodable) */
+    char map_problem[160];  /* the first such map and why */
+    int unused[MESH_UNUSED_COUNT]; /* what the file has that is not used */
     char file[256];         /* the model file, as the scene names it */
 } mesh;
 

@@ -71,7 +71,7 @@ typedef struct flatten {
     long long vertices, triangles;
     int *slot_of_material;  /* material -> slot, -1 unused */
     int slots;
-    int any_normals, any_uv;
+    int any_normals, any_uv, any_tangents;
     int skipped;
     int bad_normals;        /* vertex normals in the file that are not finite
                                or zero (replaced from the faces) */
@@ -122,6 +122,38 @@ static zt_status failf(flatten *f, const char *fmt, const char *detail, long lon
     return f->status;
 }
 
+/* Vertex v's tangent (the file's, or Assimp's from aiProcess_CalcTangentSpace)
+ * under transform t (det its determinant) into q: the direction, then the
+ * bitangent's side w, from the file's frame; w = 0 when there is none.
+ * The normal goes by the inverse transpose and the tangent by t, so a
+ * mirroring t turns the side (mesh_transform does the same). */
+static void set_tangent(const struct aiMesh *am, unsigned v, const struct aiMatrix4x4 *t,
+                        double det, float *q)
+{
+    q[0] = q[1] = q[2] = q[3] = 0.0f;
+    if (!am->mTangents || !am->mBitangents || !am->mNormals)
+        return;
+    const struct aiVector3D *tv = &am->mTangents[v], *bv = &am->mBitangents[v];
+    const struct aiVector3D *nv = &am->mNormals[v];
+    if (!is_finite3(tv) || !is_finite3(bv) || !is_finite3(nv))
+        return;
+    double x = (double)t->a1 * tv->x + (double)t->a2 * tv->y + (double)t->a3 * tv->z;
+    double y = (double)t->b1 * tv->x + (double)t->b2 * tv->y + (double)t->b3 * tv->z;
+    double z = (double)t->c1 * tv->x + (double)t->c2 * tv->y + (double)t->c3 * tv->z;
+    double l = sqrt(x * x + y * y + z * z);
+    if (!(l > 0) || !isfinite(l))
+        return;
+    /* (n x t) . b in the file's frame. */
+    double cx = (double)nv->y * tv->z - (double)nv->z * tv->y;
+    double cy = (double)nv->z * tv->x - (double)nv->x * tv->z;
+    double cz = (double)nv->x * tv->y - (double)nv->y * tv->x;
+    double side = cx * bv->x + cy * bv->y + cz * bv->z < 0 ? -1.0 : 1.0;
+    q[0] = (float)(x / l);
+    q[1] = (float)(y / l);
+    q[2] = (float)(z / l);
+    q[3] = (float)(det < 0 ? -side : side);
+}
+
 /* One instance of mesh mi under transform t. */
 static zt_status add_mesh(flatten *f, unsigned mi, const struct aiMatrix4x4 *t)
 {
@@ -139,6 +171,7 @@ static zt_status add_mesh(flatten *f, unsigned mi, const struct aiMatrix4x4 *t)
                          0, 0);
         f->any_normals |= am->mNormals != NULL;
         f->any_uv |= am->mTextureCoords[0] != NULL;
+        f->any_tangents |= am->mTangents && am->mBitangents && am->mNormals;
         if (am->mMaterialIndex < f->sc->mNumMaterials &&
             f->slot_of_material[am->mMaterialIndex] < 0)
             f->slot_of_material[am->mMaterialIndex] = f->slots++;
@@ -184,6 +217,8 @@ static zt_status add_mesh(flatten *f, unsigned mi, const struct aiMatrix4x4 *t)
                 }
             }
         }
+        if (m->tangent)
+            set_tangent(am, v, t, det, m->tangent + 4 * ((size_t)base + v));
         if (m->uv) {
             float *uv = m->uv + 2 * ((size_t)base + v);
             uv[0] = uv[1] = 0;
@@ -416,6 +451,9 @@ zt_status model_import(const char *path, const model_import_options *options, me
                      aiProcess_SortByPType | aiProcess_ValidateDataStructure;
     if (options->smooth)
         flags |= aiProcess_GenSmoothNormals;
+    /* Tangents for normal maps where the file has none (Assimp's own
+     * method, not MikkTSpace: docs/scene-format.md, "Textures"). */
+    flags |= aiProcess_CalcTangentSpace;
     import_log log;
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
@@ -456,6 +494,13 @@ zt_status model_import(const char *path, const model_import_options *options, me
     if (st == ZT_OK) {
         int slots = f.slots ? f.slots : 1;
         m = mesh_create((int)f.vertices, (int)f.triangles, options->smooth, f.any_uv, slots > 1);
+        if (m && f.any_tangents) {
+            m->tangent = calloc(4 * (size_t)f.vertices + 1, sizeof(float));
+            if (!m->tangent) {
+                mesh_release(m);
+                m = NULL;
+            }
+        }
         if (!m)
             st = zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory for %lld triangles", path,
                          f.triangles);
@@ -476,6 +521,16 @@ zt_status model_import(const char *path, const model_import_options *options, me
     if (st == ZT_OK) {
         finish_normals(m);
         st = model_materials(sc, path, f.slot_of_material, f.slots ? f.slots : 1, m, err);
+    }
+    if (st == ZT_OK && m->tangent) {
+        /* Tangents serve normal maps alone. */
+        int used = 0;
+        for (int s = 0; s < m->slot_count; s++)
+            used |= m->slots[s].normal_texture >= 0;
+        if (!used) {
+            free(m->tangent);
+            m->tangent = NULL;
+        }
     }
     if (st == ZT_OK && camera)
         read_camera(sc, path, camera);

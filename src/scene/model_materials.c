@@ -2,9 +2,9 @@
  *
  * glTF's metallic-roughness model and OBJ's MTL both reach us through
  * Assimp's material keys.  The mapping keeps what the material model can
- * show: base colour, metal, glass, emission.  glTF's thin dielectric
- * specular layer over non-metals (a 4% Fresnel reflection) and roughness
- * have no lobe here; roughness is counted so -v can say it was ignored. */
+ * show: base colour, metal, glass, roughness, emission.  glTF's thin
+ * dielectric specular layer over non-metals (a 4% Fresnel reflection) has
+ * no lobe here. */
 #define _POSIX_C_SOURCE 200809L
 #include "scene/model_materials.h"
 
@@ -19,13 +19,11 @@
 #include <assimp/scene.h>
 #include <assimp/texture.h>
 
+#include "scene/model_maps.h"
 #include "scene/texture_decode.h"
 #include "util/error.h"
 
-/* The refractive index given to metals: Schlick's term with an index this
- * small is ~1 at every angle, so the base colour is the reflectance, as
- * glTF defines a metal's. */
-#define METAL_IOR 0.01
+#define METAL_IOR MODEL_METAL_IOR /* model_maps.h */
 #define GLASS_IOR 1.5
 /* Model files are untrusted: an external texture larger than this is not
  * read (the decoder has its own limit on the decoded size). */
@@ -129,9 +127,7 @@ static int copy_texels(const struct aiTexture *t, mesh_texture *out, char *why, 
 
 /* printf into a buffer, cut to its size: the names and reasons a model
  * file supplies may be longer than a message needs. */
-static void clip_text(char *to, size_t n, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static void clip_text(char *to, size_t n, const char *fmt, ...)
+void clip_text(char *to, size_t n, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -188,48 +184,60 @@ static int load_texture(const struct aiScene *sc, const char *folder, const char
     return ok;
 }
 
+int model_texture_find(model_textures *tx, const struct aiMaterial *am, enum aiTextureType type,
+                       char *why, size_t n, zt_status *st, zt_error *err)
+{
+    if (aiGetMaterialTextureCount(am, type) == 0)
+        return -1;
+    struct aiString name;
+    enum aiTextureMapMode mode[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
+    if (aiGetMaterialTexture(am, type, 0, &name, NULL, NULL, NULL, NULL, mode, NULL) !=
+            aiReturn_SUCCESS ||
+        name.length == 0)
+        return -1;
+    mesh *m = tx->m;
+    for (int k = 0; k < m->texture_count; k++)
+        if (strcmp(tx->names[k], name.data) == 0)
+            return k;
+    if (m->texture_count >= tx->capacity) {
+        clip_text(why, n, "%s: more textures than the file has materials for", name.data);
+        return -2;
+    }
+    mesh_texture tex;
+    if (!load_texture(tx->sc, tx->folder, name.data, &tex, why, n)) {
+        if (strstr(why, "out of memory"))
+            *st = zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory for a texture", tx->path);
+        return -2;
+    }
+    tex.wrap = mode[0] != aiTextureMapMode_Clamp && mode[0] != aiTextureMapMode_Decal;
+    int k = m->texture_count++;
+    m->textures[k] = tex;
+    clip_text(tx->names[k], sizeof tx->names[k], "%s", name.data);
+    return k;
+}
+
 /* The base-colour texture of a material: glTF's base colour, else the
  * diffuse one (OBJ's map_Kd).  Textures shared by several materials are
  * decoded once.  Returns the texture index or -1. */
-static int material_texture(const struct aiScene *sc, const struct aiMaterial *am,
-                            const char *folder, mesh *m, char (*names)[256], zt_status *st,
-                            zt_error *err, const char *path)
+static int material_texture(model_textures *tx, const struct aiMaterial *am, zt_status *st,
+                            zt_error *err)
 {
     enum aiTextureType types[2] = {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE};
+    mesh *m = tx->m;
     for (int i = 0; i < 2; i++) {
-        if (aiGetMaterialTextureCount(am, types[i]) == 0)
-            continue;
-        struct aiString name;
-        enum aiTextureMapMode mode[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
-        if (aiGetMaterialTexture(am, types[i], 0, &name, NULL, NULL, NULL, NULL, mode, NULL) !=
-                aiReturn_SUCCESS ||
-            name.length == 0)
-            continue;
-        for (int k = 0; k < m->texture_count; k++)
-            if (strcmp(names[k], name.data) == 0)
-                return k;
-        mesh_texture tex;
         char why[sizeof m->texture_problem];
-        if (!load_texture(sc, folder, name.data, &tex, why, sizeof why)) {
-            if (strstr(why, "out of memory")) {
-                *st = zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory for a texture", path);
-                return -1;
-            }
-            if (m->missing_textures++ == 0)
-                snprintf(m->texture_problem, sizeof m->texture_problem, "%s", why);
-            return -1;
-        }
-        tex.wrap = mode[0] != aiTextureMapMode_Clamp && mode[0] != aiTextureMapMode_Decal;
-        int k = m->texture_count++;
-        m->textures[k] = tex;
-        clip_text(names[k], sizeof names[k], "%s", name.data);
-        return k;
+        int k = model_texture_find(tx, am, types[i], why, sizeof why, st, err);
+        if (k == -1)
+            continue;
+        if (k == -2 && *st == ZT_OK && m->missing_textures++ == 0)
+            snprintf(m->texture_problem, sizeof m->texture_problem, "%s", why);
+        return k < 0 ? -1 : k;
     }
     return -1;
 }
 
 /* One material of the file as a slot. */
-static void map_material(const struct aiMaterial *am, int gltf, mesh_slot *s)
+static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_slot *s)
 {
     memset(s, 0, sizeof *s);
     struct aiString name;
@@ -259,6 +267,8 @@ static void map_material(const struct aiMaterial *am, int gltf, mesh_slot *s)
     }
     if (get_float(am, AI_MATKEY_REFRACTI, &v) && v >= 1.0 && v <= 4.0)
         ior = v;
+    s->metallic = metallic;
+    s->transmission = transmission;
     s->mat.weight[LOBE_METALLIC] = metallic;
     s->mat.weight[LOBE_REFRACTIVE] = (1.0 - metallic) * transmission;
     s->mat.weight[LOBE_DIFFUSE] = (1.0 - metallic) * (1.0 - transmission);
@@ -279,24 +289,35 @@ static void map_material(const struct aiMaterial *am, int gltf, mesh_slot *s)
         if (isfinite(e.x) && isfinite(e.y) && isfinite(e.z))
             s->emission = e;
     }
+    /* glTF's roughness factor (default 1: a material that gives none is
+     * rough), onto the metallic and refractive lobes (diffuse has none). */
     if (get_float(am, AI_MATKEY_ROUGHNESS_FACTOR, &v))
         s->roughness = clamp01(v);
+    /* MTL without Pr: the Phong exponent Ns.  Beckmann's alpha for a Phong
+     * lobe of exponent n is sqrt(2 / (n + 2)) (Walter et al. 2007), GGX's
+     * alpha is taken equal to it, and alpha = roughness^2. */
+    else if (obj && get_float(am, AI_MATKEY_SHININESS, &v) && v >= 0.0)
+        s->roughness = clamp01(pow(2.0 / (v + 2.0), 0.25));
+    s->mat.roughness = s->roughness;
     s->texture = -1;
+    s->rough_map.texture = s->metal_map.texture = s->normal_texture = -1;
+    s->normal_scale = 1.0;
 }
 
-static int is_gltf(const char *path)
+static int has_extension(const char *path, const char *a, const char *b)
 {
     const char *dot = strrchr(path, '.');
-    return dot && (strcasecmp(dot, ".gltf") == 0 || strcasecmp(dot, ".glb") == 0);
+    return dot && (strcasecmp(dot, a) == 0 || (b && strcasecmp(dot, b) == 0));
 }
 
 zt_status model_materials(const struct aiScene *sc, const char *path,
                           const int *slot_of_material, int slot_count, mesh *m, zt_error *err)
 {
     m->slots = calloc((size_t)slot_count, sizeof *m->slots);
-    /* At most one texture per slot. */
-    m->textures = calloc((size_t)slot_count, sizeof *m->textures);
-    char(*names)[256] = calloc((size_t)slot_count, sizeof *names);
+    /* At most MODEL_SLOT_TEXTURES textures per slot. */
+    size_t capacity = (size_t)slot_count * MODEL_SLOT_TEXTURES;
+    m->textures = calloc(capacity, sizeof *m->textures);
+    char(*names)[256] = calloc(capacity, sizeof *names);
     if (!m->slots || !m->textures || !names) {
         free(names);
         return zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", path);
@@ -308,19 +329,26 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
         m->slots[s].mat.ior = 1.0;
         m->slots[s].mat.tint = v3(1, 1, 1);
         m->slots[s].texture = -1;
+        m->slots[s].rough_map.texture = m->slots[s].metal_map.texture = -1;
+        m->slots[s].normal_texture = -1;
+        m->slots[s].normal_scale = 1.0;
     }
     char folder[4096];
     folder_of(path, folder, sizeof folder);
-    int gltf = is_gltf(path);
+    int gltf = has_extension(path, ".gltf", ".glb"), obj = has_extension(path, ".obj", NULL);
+    model_textures tx = {sc, folder, path, m, names, (int)capacity};
     zt_status st = ZT_OK;
     for (unsigned i = 0; i < sc->mNumMaterials && st == ZT_OK; i++) {
         int s = slot_of_material[i];
         if (s < 0 || s >= slot_count || !sc->mMaterials[i])
             continue;
-        map_material(sc->mMaterials[i], gltf, &m->slots[s]);
-        m->slots[s].texture = material_texture(sc, sc->mMaterials[i], folder, m, names, &st,
-                                               err, path);
-        if (m->slots[s].roughness > 0.0)
+        map_material(sc->mMaterials[i], gltf, obj, &m->slots[s]);
+        m->slots[s].texture = material_texture(&tx, sc->mMaterials[i], &st, err);
+        if (st == ZT_OK)
+            st = model_maps(&tx, sc->mMaterials[i], gltf, &m->slots[s], err);
+        const material *mat = &m->slots[s].mat;
+        if (mat->roughness > 0.0 &&
+            (mat->weight[LOBE_METALLIC] > 0.0 || (mat->weight[LOBE_REFRACTIVE] > 0.0 && !mat->thin)))
             m->rough_slots++;
     }
     free(names);

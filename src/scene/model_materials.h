@@ -1,6 +1,7 @@
 /* The materials of a model file mapped onto the four-weight material, and
- * their base-colour textures decoded (docs/scene-format.md, "Materials from
- * the model file", says what maps to what). */
+ * their textures decoded: base colour here, roughness, metal and normal
+ * maps in model_maps.c (docs/scene-format.md, "Meshes from model files",
+ * says what maps to what). */
 #ifndef ZT_SCENE_MODEL_MATERIALS_H
 #define ZT_SCENE_MODEL_MATERIALS_H
 
@@ -14,7 +15,7 @@ struct aiScene;
  * A texture that is missing or cannot be decoded is left out (the slot
  * keeps its base colour) and counted in m->missing_textures with the first
  * reason in m->texture_problem: a model is still worth rendering without
- * one.  Fails only when out of memory. */
+ * one (maps: model_maps.h).  Fails only when out of memory. */
 zt_status model_materials(const struct aiScene *sc, const char *path,
                           const int *slot_of_material, int slot_count, mesh *m, zt_error *err);
 

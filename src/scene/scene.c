@@ -143,6 +143,7 @@ zt_scene *zt_scene_clone(const zt_scene *scene)
 void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
 {
     memset(out, 0, sizeof *out);
+    long long unused[MESH_UNUSED_COUNT] = {0};
     out->lights = scene->light_count;
     out->things = scene->thing_count;
     out->has_sky = scene->has_sky;
@@ -177,6 +178,11 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
         if (m->missing_textures && !out->missing_textures)
             snprintf(out->texture_problem, sizeof out->texture_problem, "%s", m->texture_problem);
         out->missing_textures += m->missing_textures;
+        if (m->map_fallbacks && !out->map_fallbacks)
+            snprintf(out->map_problem, sizeof out->map_problem, "%s", m->map_problem);
+        out->map_fallbacks += m->map_fallbacks;
+        for (int k = 0; k < MESH_UNUSED_COUNT; k++)
+            unused[k] += m->unused[k];
         for (int t = 0; t < m->triangle_count; t++) {
             int light = o->is_light || !v3_is_black(m->slots[mesh_slot_of(m, t)].emission);
             if (light)
@@ -185,6 +191,13 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
                 out->thing_parts++;
         }
     }
+    size_t len = 0;
+    for (int k = 0; k < MESH_UNUSED_COUNT; k++)
+        if (unused[k] && len < sizeof out->unused) {
+            int w = snprintf(out->unused + len, sizeof out->unused - len, "%s%lld %s",
+                             len ? ", " : "", unused[k], mesh_unused_name(k));
+            len += w > 0 ? (size_t)w : 0;
+        }
 }
 
 zt_camera zt_scene_get_camera(const zt_scene *scene)

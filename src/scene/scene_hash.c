@@ -73,11 +73,30 @@ uint64_t scene_hash(const zt_scene *sc)
                 fnv_i32(&h, sl->mat.thin);
                 fnv_v3(&h, sl->mat.tint);
             }
-            if (sl->mat.roughness > 0)
+            /* (A roughness on a diffuse-only slot shapes nothing: glTF
+             * gives every material one, and forests of such models saved
+             * before roughness was read stay valid.) */
+            if (sl->mat.roughness > 0 && sl->mat.weight[LOBE_DIFFUSE] < 1)
                 fnv_f64(&h, sl->mat.roughness);
             fnv_v3(&h, sl->emission);
             fnv_i32(&h, sl->texture);
+            /* Maps: hashed only when present (earlier forests stay valid). */
+            if (sl->rough_map.texture >= 0 || sl->metal_map.texture >= 0 ||
+                sl->normal_texture >= 0) {
+                fnv_i32(&h, sl->rough_map.texture);
+                fnv_i32(&h, sl->rough_map.channel);
+                fnv_i32(&h, sl->metal_map.texture);
+                fnv_i32(&h, sl->metal_map.channel);
+                fnv_i32(&h, sl->normal_texture);
+                fnv_f64(&h, sl->roughness);
+                fnv_f64(&h, sl->metallic);
+                fnv_f64(&h, sl->transmission);
+                fnv_f64(&h, sl->normal_scale);
+            }
         }
+        if (m->tangent)
+            fnv_bytes(&h, (const unsigned char *)m->tangent,
+                      (size_t)m->vertex_count * 4 * sizeof(float));
         fnv_i32(&h, m->texture_count);
         for (int k = 0; k < m->texture_count; k++) {
             const mesh_texture *t = &m->textures[k];

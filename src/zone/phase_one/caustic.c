@@ -122,18 +122,24 @@ static void deposit_at(tracer *t, int prim, int level, int side, vec3 x, vec3 fl
 static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
                    int glint, const specular_target *first, const int *media, int media_count);
 
-/* A photon's flux leaving part p's rough lobes at xf (nf facing it). */
-static void rough_on(tracer *t, const rs_part *p, int part, vec3f xf, vec3f nf, vec3f d,
-                     vec3 flux, double share, int k, const int *media, int media_count)
+/* A photon's flux leaving the rough lobes of part p's material m at xf (nf
+ * facing it); sh: the hit's shading when it is known already (NULL: made
+ * here). */
+static void rough_on(tracer *t, const rs_part *p, int part, const rs_object *m,
+                     const rs_shade *known, vec3f xf, vec3f nf, vec3f d, vec3 flux, double share,
+                     int k, const int *media, int media_count)
 {
     const rscene *rs = t->rs;
-    const rs_object *m = &rs->objects[p->object];
     float eta_i, eta_t;
     int entering = media_indices(rs, media, media_count, p->object, m, &eta_i, &eta_t);
-    rs_shade sh = {nf, m->color};
-    if (rs_needs_shade(rs, part, m))
-        rs_shade_at(rs, part, p, m, xf, nf, &sh);
-    zone_rough_at at = {m,     part,  xf,       nf,         sh.ns, f3_to_v3(sh.albedo), d,
+    rs_shade own; /* its mat is filled only when the maps give it */
+    own.ns = nf;
+    own.albedo = m->color;
+    own.m = NULL;
+    if (!known && rs_needs_shade(rs, part, m))
+        rs_shade_at(rs, part, p, m, xf, nf, &own);
+    const rs_shade *sh = known ? known : &own;
+    zone_rough_at at = {m,     part,  xf,       nf,         sh->ns, f3_to_v3(sh->albedo), d,
                         eta_i, eta_t, p->object, entering, media, media_count};
     vec3f wi;
     float value;
@@ -177,6 +183,18 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     vec3f ngf = shape_normal(p, xf);
     int back = f3_dot(ngf, d) > 0.0f;
     vec3f nf = back ? f3_neg(ngf) : ngf;
+    /* A material with maps: its weights and roughness here (the smooth
+     * lobes below keep the geometric normal). */
+    rs_shade sh; /* its mat is filled only when the maps give it */
+    sh.ns = nf;
+    sh.albedo = m->color;
+    sh.m = NULL;
+    const rs_shade *known = NULL;
+    if (m->maps) {
+        rs_shade_at(rs, h.part, p, m, xf, nf, &sh);
+        m = rs_shade_material(&sh, m);
+        known = &sh;
+    }
     vec3 color = f3_to_v3(m->color);
     if (k >= 1 && !glint && m->weight[LOBE_DIFFUSE] > 0.0f)
         deposit_at(t, h.part, k, back, f3_to_v3(xf), flux);
@@ -200,7 +218,7 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     /* Rough lobes send the photon on in one direction drawn from them
      * (zone_rough_scatter), the smooth ones below the rest. */
     if (m->rough)
-        rough_on(t, p, h.part, xf, nf, d, flux, share, k, media, media_count);
+        rough_on(t, p, h.part, m, known, xf, nf, d, flux, share, k, media, media_count);
     float wm = bsdf_smooth_weight(m, LOBE_METALLIC), wr = bsdf_smooth_weight(m, LOBE_REFLECTING);
     float wt = bsdf_smooth_weight(m, LOBE_REFRACTIVE);
     if (wm <= 0.0f && wr <= 0.0f && wt <= 0.0f)

@@ -79,9 +79,14 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
     vec3f nf = back ? f3_neg(ngf) : ngf;
     /* Meshes: shading normal and texture; the geometric normal decides
      * the side. */
-    rs_shade sh = {nf, m->color};
-    if (rs_needs_shade(rs, h.part, m))
+    rs_shade sh; /* its mat is filled only when the maps give it */
+    sh.ns = nf;
+    sh.albedo = m->color;
+    sh.m = NULL;
+    if (rs_needs_shade(rs, h.part, m)) {
         rs_shade_at(rs, h.part, p, m, xf, nf, &sh);
+        m = rs_shade_material(&sh, m); /* with maps: the material here */
+    }
     vec3 x = f3_to_v3(xf), n = f3_to_v3(sh.ns), color = f3_to_v3(sh.albedo);
     vec3 out = v3(0, 0, 0);
 

@@ -130,6 +130,7 @@ typedef struct surface {
     vec3f xf, nf;       /* the point and the geometric normal facing the ray */
     vec3 x, n, color;   /* n: the shading normal */
     int back;
+    rs_shade sh;        /* m may point into it (a material with maps) */
 } surface;
 
 static void surface_of(const rscene *rs, const p2_sample *s, surface *sf)
@@ -140,12 +141,17 @@ static void surface_of(const rscene *rs, const p2_sample *s, surface *sf)
     vec3f ngf = shape_normal(sf->p, sf->xf);
     sf->back = f3_dot(ngf, s->d) > 0.0f;
     sf->nf = sf->back ? f3_neg(ngf) : ngf;
-    rs_shade sh = {sf->nf, sf->m->color};
-    if (rs_needs_shade(rs, s->part, sf->m))
-        rs_shade_at(rs, s->part, sf->p, sf->m, sf->xf, sf->nf, &sh);
+    rs_shade *sh = &sf->sh;
+    sh->ns = sf->nf;
+    sh->albedo = sf->m->color;
+    sh->m = NULL;
+    if (rs_needs_shade(rs, s->part, sf->m)) {
+        rs_shade_at(rs, s->part, sf->p, sf->m, sf->xf, sf->nf, sh);
+        sf->m = rs_shade_material(sh, sf->m);
+    }
     sf->x = f3_to_v3(sf->xf);
-    sf->n = f3_to_v3(sh.ns);
-    sf->color = f3_to_v3(sh.albedo);
+    sf->n = f3_to_v3(sh->ns);
+    sf->color = f3_to_v3(sh->albedo);
 }
 
 /* Level 1 diffuse light: every light exactly, and the sky. */

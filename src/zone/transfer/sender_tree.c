@@ -23,7 +23,8 @@ static void element_albedo(const rscene *rs, int prim, const vec3 q[4], int corn
     const rs_part *p = rs_prim(rs, prim, &tmp);
     const rs_object *o = &rs->objects[p->object];
     vec3f col = o->color;
-    if (o->texture && prim >= rs->part_count) {
+    float k = o->weight[LOBE_DIFFUSE] / (float)PI;
+    if ((o->texture || (o->maps && o->maps->metal)) && prim >= rs->part_count) {
         const rs_mesh *mm = rs_mesh_of(rs, prim);
         if (mm->m->uv) {
             const uint32_t *v = rs_mesh_tri(mm, prim);
@@ -36,10 +37,14 @@ static void element_albedo(const rscene *rs, int prim, const vec3 q[4], int corn
                     uv[k][a] = b0 * mm->m->uv[2 * v[0] + a] + b1 * mm->m->uv[2 * v[1] + a] +
                                b2 * mm->m->uv[2 * v[2] + a];
             }
-            col = f3_mul(col, texture_triangle_mean(o->texture, uv[0], uv[1], uv[2], 4));
+            if (o->texture)
+                col = f3_mul(col, texture_triangle_mean(o->texture, uv[0], uv[1], uv[2], 4));
+            /* A metal map: the element's own diffuse weight, not the
+             * object's mean. */
+            if (o->maps && o->maps->metal)
+                k = rs_maps_diffuse_mean(o, uv[0], uv[1], uv[2], 4) / (float)PI;
         }
     }
-    float k = o->weight[LOBE_DIFFUSE] / (float)PI;
     out[0] = col.x * k;
     out[1] = col.y * k;
     out[2] = col.z * k;

@@ -1,0 +1,177 @@
+#!/usr/bin/env python3
+"""Writes a small glTF 2.0 model with a metallic-roughness texture and a normal texture, in plain
+Python (json, struct, zlib): a test model for model files' materials.
+
+    python3 tools/make_pbr_gltf.py OUT.gltf [--rough R] [--metal M] [--tilt DEG] [--scale S]
+                                   [--size N] [--tangents] [--base-size N] [--color R G B]
+                                   [--no-normal] [--no-mr] [--metal-right M]
+
+The model is one square of side 2 in the plane y = 0, centred on the origin, its front face (and
+normal) up, +x along the texture's u and -z along its v (so the image's left half is x < 0 and
+its top row is z = -1).  Next to OUT go OUT's stem + ".bin" (the buffer), "_mr.png" (the
+metallic-roughness texture) and "_n.png" (the normal texture), all named relative to the .gltf.
+The textures are N x N texels (--size, default 4), in halves along u:
+
+  metallic-roughness (linear, glTF's channels: G roughness, B metallic)
+      left half   G = round(255 R), B = round(255 M)      (--rough, default 1; --metal, default 1)
+      right half  G = 0,            B = round(255 M)      (a smooth metal beside a rough one;
+                                                          --metal-right sets the right half's M)
+  normal (linear, tangent space: x along +u, y along +v, z out of the surface)
+      left half   the normal tilted by DEG degrees toward +u (--tilt, default 0):
+                  (sin, 0, cos) coded as round(255 (c + 1) / 2)
+      right half  (0, 0, 1) coded the same way: (128, 128, 255)
+
+The material: baseColorFactor --color (default 1 1 1), metallicFactor and roughnessFactor 1
+(the texture holds the values), normalTexture.scale --scale (default 1).  With --base-size N a
+white base-colour texture of N x N texels is written too ("_base.png"), to try a base texture
+whose size differs from the maps'.  With --tangents the vertices carry TANGENT (+x, w = +1);
+without, the reader makes its own.  --no-normal leaves the normal texture out, --no-mr the
+metallic-roughness one (the factors then give metallic --metal and roughness --rough).
+
+Texel codes are exact: a test computes what it expects from the same rounding.
+"""
+import json
+import math
+import os
+import struct
+import sys
+import zlib
+
+
+def png(path, width, height, rows):
+    """An 8-bit RGB PNG without colour-space chunks (glTF's maps are linear)."""
+
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xffffffff)
+
+    raw = b"".join(b"\x00" + bytes(v for texel in row for v in texel) for row in rows)
+    data = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+    with open(path, "wb") as f:
+        f.write(data)
+
+
+def code(c):
+    return int(round(255 * (c + 1) / 2))
+
+
+def halves(n, left, right):
+    return [[left if i < n // 2 else right for i in range(n)] for _ in range(n)]
+
+
+def main(argv):
+    args = {"rough": 1.0, "metal": 1.0, "tilt": 0.0, "scale": 1.0, "size": 4, "tangents": False,
+            "base_size": 0, "color": [1.0, 1.0, 1.0], "normal": True, "mr": True}
+    out = None
+    i = 0
+    try:
+        while i < len(argv):
+            a = argv[i]
+            if a in ("--rough", "--metal", "--tilt", "--scale", "--metal-right"):
+                args[a[2:].replace("-", "_")] = float(argv[i + 1])
+                i += 2
+            elif a in ("--size", "--base-size"):
+                args[a[2:].replace("-", "_")] = int(argv[i + 1])
+                i += 2
+            elif a == "--color":
+                args["color"] = [float(v) for v in argv[i + 1:i + 4]]
+                i += 4
+            elif a == "--tangents":
+                args["tangents"] = True
+                i += 1
+            elif a in ("--no-normal", "--no-mr"):
+                args[a[5:]] = False
+                i += 1
+            elif a.startswith("-") or out:
+                raise ValueError(a)
+            else:
+                out = a
+                i += 1
+    except (ValueError, IndexError):
+        out = None
+    if not out or not out.endswith(".gltf") or args["size"] < 2 or args["size"] % 2:
+        sys.stderr.write(__doc__)
+        return 1
+    folder, name = os.path.split(out)
+    stem = name[:-len(".gltf")]
+    n = args["size"]
+    r = max(0, min(255, int(round(255 * args["rough"]))))
+    m = max(0, min(255, int(round(255 * args["metal"]))))
+    mr = max(0, min(255, int(round(255 * args.get("metal_right", args["metal"])))))
+    if args["mr"]:
+        png(os.path.join(folder, stem + "_mr.png"), n, n, halves(n, (0, r, m), (0, 0, mr)))
+    t = math.radians(args["tilt"])
+    if args["normal"]:
+        png(os.path.join(folder, stem + "_n.png"), n, n,
+            halves(n, (code(math.sin(t)), code(0), code(math.cos(t))), (code(0), code(0), code(1))))
+
+    # Two triangles, counter-clockwise seen from +y.
+    pos = [(-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1)]
+    uv = [(0, 1), (1, 1), (1, 0), (0, 0)]  # glTF: v down the image, so z = -1 is the top row
+    nrm = [(0, 1, 0)] * 4
+    tan = [(1, 0, 0, 1)] * 4
+    idx = [0, 1, 2, 0, 2, 3]
+    blobs = [b"".join(struct.pack("<3f", *p) for p in pos), b"".join(struct.pack("<3f", *p) for p in nrm),
+             b"".join(struct.pack("<2f", *p) for p in uv), struct.pack("<6H", *idx) + b"\x00\x00"]
+    if args["tangents"]:
+        blobs.append(b"".join(struct.pack("<4f", *p) for p in tan))
+    views, offset = [], 0
+    for b in blobs:
+        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(b)})
+        offset += len(b)
+    buffer = b"".join(blobs)
+    with open(os.path.join(folder, stem + ".bin"), "wb") as f:
+        f.write(buffer)
+    views[3]["byteLength"] = 12
+    accessors = [
+        {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, 0, -1],
+         "max": [1, 0, 1]},
+        {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+        {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+        {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"},
+    ]
+    attributes = {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}
+    if args["tangents"]:
+        accessors.append({"bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC4"})
+        attributes["TANGENT"] = 4
+    images = []
+    pbr = {"baseColorFactor": args["color"] + [1.0], "metallicFactor": 1.0, "roughnessFactor": 1.0}
+    if args["mr"]:
+        pbr["metallicRoughnessTexture"] = {"index": len(images)}
+        images.append({"uri": stem + "_mr.png"})
+    else:
+        pbr["metallicFactor"], pbr["roughnessFactor"] = args["metal"], args["rough"]
+    material = {"name": "pbr", "pbrMetallicRoughness": pbr}
+    if args["normal"]:
+        material["normalTexture"] = {"index": len(images), "scale": args["scale"]}
+        images.append({"uri": stem + "_n.png"})
+    if args["base_size"] > 0:
+        b = args["base_size"]
+        png(os.path.join(folder, stem + "_base.png"), b, b, [[(255, 255, 255)] * b] * b)
+        pbr["baseColorTexture"] = {"index": len(images)}
+        images.append({"uri": stem + "_base.png"})
+    doc = {
+        "asset": {"version": "2.0", "generator": "zonetrace tools/make_pbr_gltf.py"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": attributes, "indices": 3, "material": 0}]}],
+        "materials": [material],
+        # Nearest filtering is not asked for: the renderer filters bilinearly anyway, and the
+        # halves are wide enough to be read away from their border.
+        "samplers": [{"wrapS": 33071, "wrapT": 33071}],
+        "textures": [{"source": k, "sampler": 0} for k in range(len(images))],
+        "images": images,
+        "buffers": [{"uri": stem + ".bin", "byteLength": len(buffer)}],
+        "bufferViews": views,
+        "accessors": accessors,
+    }
+    with open(out, "w") as f:
+        json.dump(doc, f, indent=1)
+        f.write("\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
