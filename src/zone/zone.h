@@ -202,6 +202,11 @@ typedef struct zone_trace {
     /* The camera sample's weight in its pixel (rough.c shares the pixel's
      * directions by it); 0 on rays that are not a camera sample's. */
     double sample_share;
+    /* Set by a camera sample's rough lobe for the rays of its directions:
+     * the direction's point of the sequence, which a second rough lobe on
+     * the way takes in another set of numbers (rough.c); 0: none. */
+    int rough_nested;
+    double rough_j;
 } zone_trace;
 
 /* Irradiance of level `level` at point x (normal n) on side `side` of

@@ -51,11 +51,55 @@
 /* The light samples read R2 this far along: a fixed shift of the lobe's
  * points. */
 #define LIGHT_SHIFT 0.5
+/* The 4-D R-sequence's number (g^5 = g + 1), whose powers 1/g^k drive the
+ * second set of numbers (point_numbers_at). */
+#define R4_G 1.16730397826141868426
 
 static float frac_f(double x)
 {
     double f = x - floor(x);
     return f < 1.0 ? (float)f : 0.99999994f;
+}
+
+/* The numbers a direction takes from point j of the sequence.  Set 0 is a
+ * camera sample's own: R2 for the direction, irrationals unrelated to it
+ * for the choices.  Set 1 is for a ray from one of its directions that
+ * meets a second rough lobe on its way (the far side of a rough glass):
+ * the 4-D R-sequence's irrationals, so that the pair of directions spreads
+ * over four dimensions, where taking set 0 again would put the second on
+ * a fixed offset of the first. */
+typedef struct point_numbers {
+    float u2[2];         /* the direction */
+    float choice, split; /* which lobe; reflect or refract */
+    float l2[2];         /* a light sample's point */
+    float light, far;    /* which light; the sun or the map */
+} point_numbers;
+
+static void point_numbers_at(double j, int set, point_numbers *p)
+{
+    if (set == 0) {
+        double u, v;
+        r2_point(j, &u, &v);
+        p->u2[0] = (float)u;
+        p->u2[1] = (float)v;
+        r2_point(j + LIGHT_SHIFT, &u, &v);
+        p->l2[0] = (float)u;
+        p->l2[1] = (float)v;
+        p->choice = frac_f(0.5 + j * GOLDEN);
+        p->split = frac_f(0.5 + j * SQRT2_1);
+        p->light = frac_f(0.5 + j * SQRT3_1);
+        p->far = frac_f(0.5 + j * SQRT2_1 + 0.25);
+        return;
+    }
+    double a1 = 1.0 / R4_G, a2 = a1 * a1, a3 = a2 * a1, a4 = a3 * a1;
+    p->u2[0] = frac_f(0.5 + j * a3);
+    p->u2[1] = frac_f(0.5 + j * a4);
+    p->l2[0] = frac_f(0.5 + (j + LIGHT_SHIFT) * a3);
+    p->l2[1] = frac_f(0.5 + (j + LIGHT_SHIFT) * a4);
+    p->choice = frac_f(0.5 + j * a1);
+    p->split = frac_f(0.5 + j * a2);
+    p->light = frac_f(0.75 + j * SQRT3_1);
+    p->far = frac_f(0.75 + j * SQRT2_1 + 0.25);
 }
 
 /* A point of the sequence for a ray that meets a rough lobe on its way. */
@@ -96,16 +140,14 @@ static float lobes_eval(const zone_rough_at *s, const shading_frame *fr, unsigne
 /* Level 0 by light samples: the lights (not under ZR_NO_CAUSTIC: photons
  * carry their light by specular surfaces there) and light from far away. */
 static vec3 light_samples(zone_trace *t, const zone_rough_at *s, const shading_frame *fr,
-                          unsigned lobes, float weight_sum, double j, int flags)
+                          unsigned lobes, float weight_sum, const point_numbers *pn, int flags)
 {
     const rscene *rs = &t->r->rs;
     vec3 out = v3(0, 0, 0);
-    double u, v;
-    r2_point(j + LIGHT_SHIFT, &u, &v);
-    const float u2[2] = {(float)u, (float)v};
+    const float *u2 = pn->l2;
     light_sample ls;
     if (!(flags & ZR_NO_CAUSTIC) && rs->light_count > 0 &&
-        light_sample_point(rs, s->x, frac_f(0.5 + j * SQRT3_1), u2, &ls) && !f3_is_black(ls.li)) {
+        light_sample_point(rs, s->x, pn->light, u2, &ls) && !f3_is_black(ls.li)) {
         float pdf, f = lobes_eval(s, fr, lobes, weight_sum, ls.wi, &pdf);
         if (f > 0.0f) {
             int below = f3_dot(s->ng, ls.wi) < 0.0f;
@@ -124,7 +166,7 @@ static vec3 light_samples(zone_trace *t, const zone_rough_at *s, const shading_f
     }
     vec3f wi, li;
     float far_pdf;
-    float u_pick = rs->distant.map && rs->distant.sun ? frac_f(0.5 + j * SQRT2_1 + 0.25) : 0.0f;
+    float u_pick = rs->distant.map && rs->distant.sun ? pn->far : 0.0f;
     if (rs->distant.any && distant_sample(&rs->distant, u_pick, u2, &wi, &far_pdf, &li) &&
         !f3_is_black(li)) {
         float pdf, f = lobes_eval(s, fr, lobes, weight_sum, wi, &pdf);
@@ -164,14 +206,11 @@ static void frame_of(const zone_rough_at *s, shading_frame *fr)
  * density (0 for the straight line of an index-matched glass, whose value
  * is 1). */
 static int scatter(const zone_rough_at *s, const shading_frame *fr, unsigned lobes,
-                   float weight_sum, double j, vec3f *wi, float *pdf, float *value)
+                   float weight_sum, const point_numbers *pn, vec3f *wi, float *pdf, float *value)
 {
-    double u, v;
-    r2_point(j, &u, &v);
-    const float u2[2] = {(float)u, (float)v};
     bsdf_sample bs;
-    if (!bsdf_sample_rough_lobes(s->m, lobes, fr, f3_neg(s->d), frac_f(0.5 + j * GOLDEN),
-                                 frac_f(0.5 + j * SQRT2_1), u2, s->eta_i, s->eta_t, &bs))
+    if (!bsdf_sample_rough_lobes(s->m, lobes, fr, f3_neg(s->d), pn->choice, pn->split, pn->u2,
+                                 s->eta_i, s->eta_t, &bs))
         return 0;
     *wi = bs.wi;
     if (bs.delta) {
@@ -194,18 +233,21 @@ int zone_rough_scatter(const zone_rough_at *s, vec3f *wi, float *value)
         return 0;
     shading_frame fr;
     frame_of(s, &fr);
-    return scatter(s, &fr, lobes, weight_sum, hashed_index(s->x, s->d), wi, &pdf, value);
+    point_numbers pn;
+    point_numbers_at(hashed_index(s->x, s->d), 0, &pn);
+    return scatter(s, &fr, lobes, weight_sum, &pn, wi, &pdf, value);
 }
 
 /* The lobes' light of levels lo..hi along one direction (point j): f cos
  * over the density times the forest's radiance there; light of level 0
  * weighed against the light samples. */
 static vec3 lobe_ray(zone_trace *t, const zone_rough_at *s, const shading_frame *fr,
-                     unsigned lobes, float weight_sum, double j, int lo, int hi, int flags)
+                     unsigned lobes, float weight_sum, const point_numbers *pn, int lo, int hi,
+                     int flags)
 {
     vec3f wi;
     float pdf, f;
-    if (!scatter(s, fr, lobes, weight_sum, j, &wi, &pdf, &f))
+    if (!scatter(s, fr, lobes, weight_sum, pn, &wi, &pdf, &f))
         return v3(0, 0, 0);
     int through = f3_dot(s->ng, wi) < 0.0f;
     vec3f o = ray_offset(s->x, through ? f3_neg(s->ng) : s->ng);
@@ -229,21 +271,26 @@ static int sample_count(int per_pixel, double share, int least)
     return k > least ? k : least;
 }
 
-/* Where a sample's points lie in the sequence: a camera sample's pixel has
- * its own stretch, which its samples take interleaved (sample i of n the
- * points i, i + n, i + 2n, ...), so that the pixel as a whole integrates
- * over evenly spread points; a ray on its way starts where a hash of the
- * point says. */
+/* Where a sample's points lie in the sequence, and in which set of
+ * numbers: a camera sample's pixel has its own stretch, which its samples
+ * take interleaved (sample i of n the points i, i + n, i + 2n, ...), so
+ * that the pixel as a whole integrates over evenly spread points; a ray
+ * from one of those directions takes that direction's point in the second
+ * set (t->rough_nested); any other ray starts where a hash of the point
+ * says. */
 typedef struct seq {
     double first, step;
+    int set;
 } seq;
 
-static seq sequence(const zone_gather_slot *slot, int camera, int per_pixel,
+static seq sequence(const zone_trace *t, const zone_gather_slot *slot, int camera, int per_pixel,
                     const zone_rough_at *s)
 {
-    if (!camera)
-        return (seq){hashed_index(s->x, s->d), 1.0};
-    return (seq){(double)slot->pixel * per_pixel + slot->sample + 1, slot->samples};
+    if (camera)
+        return (seq){(double)slot->pixel * per_pixel + slot->sample + 1, slot->samples, 0};
+    if (t->rough_nested)
+        return (seq){t->rough_j, 1.0, 1};
+    return (seq){hashed_index(s->x, s->d), 1.0, 0};
 }
 
 vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, int lo, int hi,
@@ -276,6 +323,13 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
      * at their ends is a point's own (no shared split). */
     int save_split = t->light_split;
     t->light_split = 0;
+    /* This lobe's sequence: a nested lobe's point is taken (rays beyond it
+     * hash their own). */
+    seq sq0 = sequence(t, &slot, camera, q->rough_light_pixel, s);
+    seq sq = sequence(t, &slot, camera, q->rough_pixel, s);
+    int save_nested = t->rough_nested;
+    double save_j = t->rough_j;
+    t->rough_nested = 0;
     vec3 sum = v3(0, 0, 0);
     t->sample_share = 0.0;
     /* Level 0: its own, larger set of directions and light samples: they
@@ -283,26 +337,33 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
      * is small and bright. */
     if (lo == 0) {
         int k0 = camera ? sample_count(q->rough_light_pixel, share, q->rough_sample) : 1;
-        seq sq = sequence(&slot, camera, q->rough_light_pixel, s);
         vec3 l0 = v3(0, 0, 0);
         for (int k = 0; k < k0; k++) {
-            double j = sq.first + sq.step * k;
-            l0 = v3_add(l0, light_samples(t, s, &fr, lobes, weight_sum, j, flags));
-            l0 = v3_add(l0, lobe_ray(t, s, &fr, lobes, weight_sum, j, 0, 0, exact_direct | cflags));
+            point_numbers pn;
+            point_numbers_at(sq0.first + sq0.step * k, sq0.set, &pn);
+            l0 = v3_add(l0, light_samples(t, s, &fr, lobes, weight_sum, &pn, flags));
+            l0 = v3_add(l0, lobe_ray(t, s, &fr, lobes, weight_sum, &pn, 0, 0, exact_direct | cflags));
         }
         sum = v3_add(sum, v3_scale(l0, (double)k_max / k0));
         lo = 1;
     }
     /* What the lobe's rays meet: a mesh gathers a share of the camera
      * sample's directions (gather.c), a rough lobe takes one. */
-    seq sq = sequence(&slot, camera, q->rough_pixel, s);
     for (int k = 0; k < k_max && lo <= hi; k++) {
-        if (camera)
+        double j = sq.first + sq.step * k;
+        if (camera) {
             t->gather = (zone_gather_slot){slot.pixel, (uint16_t)k, (uint16_t)k_max, 0, 0};
-        sum = v3_add(sum, lobe_ray(t, s, &fr, lobes, weight_sum, sq.first + sq.step * k, lo, hi,
+            t->rough_nested = 1;
+            t->rough_j = j;
+        }
+        point_numbers pn;
+        point_numbers_at(j, sq.set, &pn);
+        sum = v3_add(sum, lobe_ray(t, s, &fr, lobes, weight_sum, &pn, lo, hi,
                                    exact_direct | cflags));
     }
     t->gather = slot;
+    t->rough_nested = save_nested;
+    t->rough_j = save_j;
     t->sample_share = share;
     t->mis_pdf = 0.0f;
     t->light_split = save_split;
