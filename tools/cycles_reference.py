@@ -3,10 +3,11 @@
     blender -b -P tools/cycles_reference.py -- SCENE.json OUT.pfm --spp N [--seed S]
             [--size WxH] [--bounces B] [--plane-size H] [--light-offset D]
             [--sphere-subdivisions K] [--light-subdivisions K] [--scale U] [--ggx multi|single]
-            [--threads T]
+            [--threads T] [--no-dielectric-specular]
 
 Writes OUT as linear float RGB (PFM, bottom row first, as zonetrace writes it; an OUT ending in
-.exr is written as OpenEXR instead).  Needs Blender 3.4 (scripts/install-reference-tools.sh).
+.exr is written as OpenEXR instead).  Needs Blender 3.4, and numpy for its glTF importer
+(scripts/install-reference-tools.sh).
 
 Supported, and nothing else (anything else stops the script with a message naming it):
   top level   "camera", "scene"
@@ -75,6 +76,42 @@ Supported, and nothing else (anything else stops the script with a message namin
                 --ggx single takes single-scattering GGX lobes instead (to compare with a
                 zonetrace built without compensation): the mirrors then agree exactly, the
                 glasses not quite (the furnace: Cycles 0.968, zonetrace 0.985)
+  models      "mesh" {"file", "transform", "material", "backculled", "smooth"} for glTF files
+                (.gltf, .glb) only: imported by Blender's own glTF importer (+Y up converted
+                to Blender's +Z up, which is the script's own (x, y, z) -> (x, -z, y)), then
+                placed by zonetrace's transform exactly as src/scene/load_mesh.c builds it:
+                p -> A p + t, A = R_n ... R_1 S ("scale" first, then each "rotate" in order,
+                right-handed about the axis through the origin, then "translate"), applied to
+                the file's node transforms.  The materials are Blender's as imported: a
+                Principled BSDF reading the base colour, the metallic-roughness texture and
+                the normal texture (Normal Map node, tangent space, MikkTSpace tangents from
+                the UVs) by itself, so Cycles' image checks how zonetrace reads them.  The
+                only changes: the Principled distribution is --ggx's (Multiscatter GGX by
+                default, as zonetrace compensates its single-scattering lobes; the importer
+                leaves GGX), and with "backculled" a Transparent BSDF on the back.  "material"
+                replaces every imported material by the script's own (as for other things);
+                "smooth": false shades flat facets.
+              Refused (with the reason): other formats, "emission" and "background" on a
+                mesh, a mirroring transform, glTF extensions, more than one scene, skins,
+                animations, morph targets, vertex colours, triangles without a material or
+                (with "smooth") without normals, alpha modes other than OPAQUE, emissive
+                materials, textures on a texCoord other than 0, NEAREST magnification or
+                MIRRORED_REPEAT samplers, a normal texture's scale other than 1 (Blender's
+                Normal Map strength blends the unmapped and the mapped normal, glTF scales
+                x and y before normalising: they agree at 1 only), lights in the file;
+                cameras in the file are left out.  Tangents given in the file are not used
+                by Blender (MikkTSpace always); zonetrace uses them (or Assimp's own when
+                the file has none), which agree with MikkTSpace on flat, evenly mapped
+                faces.
+              Known differences that remain (the script keeps Blender's materials):
+                glTF's specular layer over non-metals (Principled's Specular 0.5, F0 0.04)
+                is not rendered by zonetrace: --no-dielectric-specular sets the imported
+                Principled BSDFs' Specular to 0, a diagnostic to tell that layer from
+                everything else; Blender 3.4's Principled diffuse is Burley's (Disney)
+                diffuse, which depends on the roughness and darkens at grazing angles,
+                zonetrace's is Lambert's; a glTF metal's Fresnel is Principled's, F0 the
+                base colour (1 for white), zonetrace's is Schlick's with an index of 0.01
+                (F0 0.961)
   far light   "sun" {"direction", "irradiance", "angle" (0.53)}: a sun lamp whose strength is the
                 irradiance on a surface facing it (W/m^2, per channel through the lamp colour)
               "sky" {"color"}: the world's background colour (radiance, W/m^2/sr)
@@ -82,7 +119,8 @@ Supported, and nothing else (anything else stops the script with a message namin
                 texture (OpenEXR, Radiance HDR, or PFM), nearest-texel lookup as zonetrace's
 Not supported: "lightpoint", a rough "metallic" lobe (zonetrace takes Schlick's Fresnel at each
 microfacet, which no Cycles 3.4 node can), "thin" panes, "background" on anything but planes or
-where a foreground part or the camera stands behind the plane, meshes, sky models, a sun by
+where a foreground part or the camera stands behind the plane, meshes other than glTF
+(and what "models" above lists), sky models, a sun by
 "place", a skewed or mirroring screen, the legacy non-JSON group syntax.
 
 Frames: zonetrace's +y is Blender's +Z, (x, y, z) -> (x, -z, y), times --scale.  Render
@@ -95,6 +133,7 @@ import array
 import json
 import math
 import os
+import struct
 import sys
 import tempfile
 import time
@@ -307,6 +346,19 @@ def check_background(objs, cam_points, offset):
                     fail("%s: a foreground %s stands behind the background plane of %s "
                          "(Cycles has no background rule)" % (o.where, kind, bo.where))
     return len(planes)
+
+
+def check_models_background(objs, points):
+    """Imported models must lie on every background plane's front side, as other parts."""
+    for o in objs:
+        if not o.background:
+            continue
+        for kind, g in o.parts:
+            n, d = g["normal"], g["offset"]
+            for p in points:
+                if n.dot(p) < d - 1e-6 * max(1.0, abs(d), *[abs(x) for x in p]):
+                    fail("a model stands behind the background plane of %s (Cycles has no "
+                         "background rule)" % o.where)
 
 
 # ---------------------------------------------------------------- materials
@@ -623,6 +675,267 @@ def build_object(o, ctx):
                  mat)
 
 
+# ---------------------------------------------------------------- model files (glTF)
+
+MESH_KEYS = {"file", "transform", "material", "backculled", "smooth"}
+GLTF_MAX_JSON = 64 << 20
+
+
+def mat3_rotation(axis, degrees):
+    """zonetrace's load_mesh.c: the right-handed rotation about a unit axis, in degrees."""
+    x, y, z = axis
+    a = math.radians(degrees)
+    c, s = math.cos(a), math.sin(a)
+    k = 1 - c
+    return Matrix(((c + x * x * k, x * y * k - z * s, x * z * k + y * s),
+                   (y * x * k + z * s, c + y * y * k, y * z * k - x * s),
+                   (z * x * k - y * s, z * y * k + x * s, c + z * z * k)))
+
+
+def mesh_transform(tr, what):
+    """zonetrace's load_transform: p -> A p + t, A = R_n ... R_1 S (scale first, then each
+    rotation in order, then the translation), in the scene's frame."""
+    a = Matrix.Identity(3)
+    t = Vector((0, 0, 0))
+    if tr is None:
+        return a, t
+    keys_ok(tr, {"scale", "rotate", "translate"}, what)
+    if "scale" in tr:
+        s = tr["scale"]
+        s = triple(s, what + " scale") if isinstance(s, list) else [number(s, what + " scale")] * 3
+        if 0 in s:
+            fail("%s: a scale factor of 0 flattens the model" % what)
+        a = Matrix.Diagonal(Vector(s))
+    if "rotate" in tr:
+        rot = tr["rotate"]
+        if not isinstance(rot, list):
+            fail("%s: rotate must be a list of [ax, ay, az, degrees]" % what)
+        for r in rot:
+            if not isinstance(r, list) or len(r) != 4:
+                fail("%s: a rotation is [ax, ay, az, degrees]" % what)
+            axis = Vector(triple(r[:3], what + " rotation axis"))
+            if not axis.length > 0:
+                fail("%s: a rotation's axis is zero" % what)
+            a = mat3_rotation(axis.normalized(), number(r[3], what + " rotation angle")) @ a
+    if "translate" in tr:
+        t = Vector(triple(tr["translate"], what + " translate"))
+    if a.determinant() < 0:
+        fail("%s: a mirroring transform is not supported (zonetrace turns the winding and the "
+             "tangents' side; not checked against Blender's handling)" % what)
+    return a, t
+
+
+def read_gltf_json(path):
+    """The glTF's JSON: the whole .gltf, or a .glb's first (JSON) chunk."""
+    with open(path, "rb") as f:
+        head = f.read(12)
+        if head[:4] == b"glTF":
+            if len(head) < 12:
+                fail("%s: truncated .glb" % path)
+            length, kind = struct.unpack("<II", f.read(8))
+            if kind != 0x4E4F534A or length > GLTF_MAX_JSON:
+                fail("%s: a .glb whose first chunk is not JSON" % path)
+            text = f.read(length)
+        else:
+            text = head + f.read(GLTF_MAX_JSON)
+    try:
+        return json.loads(text.decode("utf-8"))
+    except (ValueError, UnicodeDecodeError) as e:
+        fail("%s: not glTF JSON: %s" % (path, e))
+
+
+def check_gltf(doc, path, override, smooth):
+    """Refuses what Blender's importer and zonetrace's Assimp reading would not render alike."""
+    def no(msg):
+        fail("%s: %s" % (path, msg))
+    if not isinstance(doc, dict) or not str(doc.get("asset", {}).get("version", "")).startswith("2"):
+        no("not a glTF 2 file")
+    ext = sorted(set(doc.get("extensionsUsed", [])) | set(doc.get("extensionsRequired", [])))
+    if ext:
+        no("glTF extensions are not supported by this script (%s): zonetrace reads some "
+           "(KHR_materials_ior, transmission, volume), not all as Blender does" % ", ".join(ext))
+    if len(doc.get("scenes", [])) > 1:
+        no("more than one scene (zonetrace flattens every node, Blender imports one scene)")
+    if doc.get("skins") or doc.get("animations"):
+        no("skins and animations are not supported (which pose each reader takes differs)")
+    for sampler in doc.get("samplers", []):
+        if sampler.get("magFilter") == 9728:
+            no("a sampler with NEAREST magnification: Blender would read it nearest, zonetrace "
+               "always bilinearly")
+        if 33648 in (sampler.get("wrapS"), sampler.get("wrapT")):
+            no("a MIRRORED_REPEAT sampler (zonetrace repeats or clamps)")
+    for mesh in doc.get("meshes", []):
+        for prim in mesh.get("primitives", []):
+            attrs = prim.get("attributes", {})
+            if prim.get("targets"):
+                no("morph targets are not supported")
+            if any(k.startswith("COLOR_") for k in attrs):
+                no("vertex colours are not supported (Blender's importer multiplies the base "
+                   "colour by them, zonetrace does not)")
+            if smooth and "NORMAL" not in attrs and prim.get("mode", 4) in (4, 5, 6):
+                no("triangles without NORMAL with \"smooth\": zonetrace makes smooth normals "
+                   "(60 degrees), Blender's importer flat ones; give \"smooth\": false")
+            if override is None and "material" not in prim and prim.get("mode", 4) in (4, 5, 6):
+                no("triangles without a material (the two readers' default materials differ); "
+                   "give the mesh a \"material\"")
+    if override is not None:
+        return
+    for i, m in enumerate(doc.get("materials", [])):
+        what = "material %d (%s)" % (i, m.get("name", "unnamed"))
+        if m.get("alphaMode", "OPAQUE") != "OPAQUE":
+            no("%s: alphaMode %s is not supported (zonetrace leaves coverage out)"
+               % (what, m["alphaMode"]))
+        if m.get("emissiveTexture") or any(m.get("emissiveFactor", [0, 0, 0])):
+            no("%s: an emissive material is not supported by this script" % what)
+        pbr = m.get("pbrMetallicRoughness", {})
+        infos = [pbr.get("baseColorTexture"), pbr.get("metallicRoughnessTexture"),
+                 m.get("normalTexture")]
+        for info in infos:
+            if info and info.get("texCoord", 0) != 0:
+                no("%s: a texture on texCoord %d (only TEXCOORD_0 is supported)"
+                   % (what, info["texCoord"]))
+        nt = m.get("normalTexture")
+        if nt and nt.get("scale", 1.0) != 1.0:
+            # glTF scales x and y before normalising; Blender's Normal Map strength blends
+            # the unmapped and the mapped normal.  They agree at 1 only.
+            no("%s: a normal texture's scale of %g (Blender's Normal Map strength is not "
+               "glTF's scale but at 1)" % (what, nt["scale"]))
+
+
+def import_gltf(path):
+    """Blender's own importer, +Y up converted to +Z up: glTF's (x, y, z) is Blender's
+    (x, -z, y), the script's own mapping (to_blender) without the scale."""
+    # Blender 3.4's importer uses numpy.bool, an alias numpy 1.24 removed (it was bool).
+    import numpy
+    if "bool" not in numpy.__dict__:
+        numpy.bool = bool
+    before = set(bpy.data.objects)
+    res = bpy.ops.import_scene.gltf(filepath=path, import_shading="NORMALS",
+                                    bone_heuristic="TEMPERANCE", guess_original_bind_pose=True)
+    if "FINISHED" not in res:
+        fail("%s: Blender's glTF importer failed" % path)
+    return [o for o in bpy.data.objects if o not in before]
+
+
+def backface_transparent(mat):
+    """An imported material's surface with a Transparent BSDF on its back (backculled)."""
+    nt = mat.node_tree
+    outs = [n for n in nt.nodes if n.type == "OUTPUT_MATERIAL"]
+    if not outs or not outs[0].inputs["Surface"].is_linked:
+        fail("material %s has no surface output" % mat.name)
+    out = outs[0]
+    src = out.inputs["Surface"].links[0].from_socket
+    geo = nt.nodes.new("ShaderNodeNewGeometry")
+    clear = nt.nodes.new("ShaderNodeBsdfTransparent")
+    clear.inputs["Color"].default_value = (1, 1, 1, 1)
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    nt.links.new(geo.outputs["Backfacing"], mix.inputs["Fac"])
+    nt.links.new(src, mix.inputs[1])
+    nt.links.new(clear.outputs["BSDF"], mix.inputs[2])
+    nt.links.new(mix.outputs["Shader"], out.inputs["Surface"])
+
+
+def prepare_imported_material(mat, args):
+    """Keeps Blender's Principled BSDF as imported; sets the distribution (--ggx) and, as a
+    diagnostic, the dielectric specular layer off (--no-dielectric-specular)."""
+    if not mat.use_nodes:
+        fail("imported material %s has no nodes" % mat.name)
+    bsdfs = [n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED"]
+    if len(bsdfs) != 1:
+        fail("imported material %s: %d Principled BSDFs (one expected)" % (mat.name, len(bsdfs)))
+    p = bsdfs[0]
+    p.distribution = GGX_KIND[0]
+    if args.no_dielectric_specular:
+        spec = p.inputs["Specular"]
+        if spec.is_linked:
+            fail("imported material %s: its Specular is a texture" % mat.name)
+        spec.default_value = 0.0
+
+
+def add_model(item, index, scene_dir, ctx, args):
+    """A "mesh" item: a glTF file imported by Blender, placed by zonetrace's transform."""
+    where = "scene item %d (mesh)" % index
+    keys_ok(item, MESH_KEYS | {"emission", "background"}, where)
+    for k in ("emission", "background"):
+        if k in item:
+            fail("%s: %r on a mesh is not supported by this script" % (where, k))
+    if "file" not in item or not isinstance(item["file"], str) or not item["file"]:
+        fail("%s: \"file\" must be a non-empty string" % where)
+    path = item["file"]
+    if not os.path.isabs(path):
+        path = os.path.join(scene_dir, path)
+    if not path.lower().endswith((".gltf", ".glb")):
+        fail("%s: %s: only glTF models (.gltf, .glb) are supported: other formats go through "
+             "importers that differ from Assimp's" % (where, item["file"]))
+    backculled = boolean(item.get("backculled", False), where + " backculled")
+    smooth = boolean(item.get("smooth", True), where + " smooth")
+    a, t = mesh_transform(item.get("transform"), where + " transform")
+    override = item.get("material")
+    check_gltf(read_gltf_json(path), item["file"], override, smooth)
+    objs = import_gltf(path)
+    for o in objs:
+        if o.type == "LIGHT":
+            fail("%s: the file has lights (this script leaves them out)" % where)
+    for o in [o for o in objs if o.type not in ("MESH", "EMPTY")]:
+        bpy.data.objects.remove(o)  # cameras: zonetrace's mesh item leaves them out
+    objs = [o for o in objs if o.name in bpy.data.objects]
+    # Our p -> A p + t in Blender's frame: C (A (C^-1 v) + t) x the scale, C = to_blender's.
+    c = Matrix(((1, 0, 0), (0, 0, -1), (0, 1, 0)))
+    m = (c @ a @ c.transposed()).to_4x4() * UNIT[0]
+    m.translation = to_blender(t)
+    m[3][3] = 1.0
+    meshes = 0
+    own = {}
+    for o in objs:
+        if o.parent is None or o.parent not in objs:
+            o.matrix_world = m @ o.matrix_world
+    bpy.context.view_layer.update()
+    mat = None
+    if override is not None:
+        mat = thing_material(override, backculled, ctx["materials"], where + ": material")
+    for o in objs:
+        if o.type != "MESH":
+            continue
+        meshes += 1
+        o.cycles.shadow_terminator_geometry_offset = 0.0
+        o.cycles.shadow_terminator_offset = 0.0
+        me = o.data
+        if not smooth:
+            me.use_auto_smooth = False  # custom normals are then ignored
+            for poly in me.polygons:
+                poly.use_smooth = False
+        if mat is not None:
+            me.materials.clear()
+            me.materials.append(mat)
+            continue
+        for slot in o.material_slots:
+            if slot.material is None:
+                fail("%s: a mesh part without a material" % where)
+            if slot.material.name not in own:
+                own[slot.material.name] = slot.material
+                prepare_imported_material(slot.material, args)
+    if backculled:
+        for im in own.values():  # each import makes its own materials
+            backface_transparent(im)
+    if meshes == 0:
+        fail("%s: no mesh in the file" % where)
+    ctx["models"] += 1
+    ctx["model_materials"] += len(own)
+    return objs
+
+
+def model_points(objs):
+    """The world-space vertices of imported meshes, back in the scene's frame."""
+    pts = []
+    for o in objs:
+        if o.type == "MESH":
+            mw = o.matrix_world
+            for v in o.data.vertices:
+                p = mw @ v.co
+                pts.append(Vector((p.x, p.z, -p.y)) / UNIT[0])
+    return pts
+
+
 # ---------------------------------------------------------------- light from far away
 
 def load_pfm_image(path):
@@ -924,6 +1237,10 @@ def main(argv):
                     help="rough lobes: Multiscatter GGX (default), or single-scattering GGX "
                          "(to compare with a zonetrace built without its compensation)")
     ap.add_argument("--threads", type=int, default=0, help="render threads (0: all)")
+    ap.add_argument("--no-dielectric-specular", action="store_true",
+                    help="diagnostic: the imported Principled BSDFs' Specular set to 0, leaving "
+                         "out glTF's specular layer over non-metals (F0 0.04), which zonetrace "
+                         "does not render")
     args = ap.parse_args(argv)
     GGX_KIND[0] = "MULTI_GGX" if args.ggx == "multi" else "GGX"
     if not 0 <= args.sphere_subdivisions <= 8:
@@ -947,6 +1264,7 @@ def main(argv):
     eye, tl, tr, bl, _, _, view_centre = corners
     cam_points = [eye, tl, tr, bl, tr + bl - tl]
     objs = []
+    meshes = []
     sky = sun = None
     for index, item in enumerate(doc["scene"]):
         if not isinstance(item, dict) or len(item) != 1:
@@ -955,6 +1273,10 @@ def main(argv):
         if kind in THING_PRIMS or kind in LIGHT_PRIMS or kind in ("thing", "light",
                                                                    "lightpoint"):
             objs.append(parse_item(kind, body, index))
+        elif kind == "mesh":
+            if not isinstance(body, dict):
+                fail("scene item %d (mesh) must be an object" % index)
+            meshes.append((index, body))
         elif kind == "sun":
             if sun is not None:
                 fail("a second sun")
@@ -989,17 +1311,29 @@ def main(argv):
     ctx = {"materials": {}, "view_centre": view_centre, "plane_size": args.plane_size,
            "cam_points": cam_points, "sphere_k": args.sphere_subdivisions, "spheres": {},
            "mesh_spheres": 0, "light_k": args.light_subdivisions, "light_pieces": 0,
-           "solid_angle_within": 0.0}
+           "solid_angle_within": 0.0, "models": 0, "model_materials": 0}
     for o in objs:
         build_object(o, ctx)
+    scene_dir = os.path.dirname(os.path.abspath(args.scene))
+    model_objs = []
+    for index, body in meshes:
+        model_objs += add_model(body, index, scene_dir, ctx, args)
+    if model_objs and nbg:
+        check_models_background(objs, model_points(model_objs))
     if sun is not None:
         add_sun(sun)
-    setup_world(sky, os.path.dirname(os.path.abspath(args.scene)))
+    setup_world(sky, scene_dir)
     render_settings(s, w, h, pixel_aspect, args)
     print("cycles_reference: %d objects (%d lights), %d background planes, %d triangles moved "
           "%g off them, %d spheres as meshes of %d triangles"
           % (len(objs), sum(o.cls == "light" for o in objs), nbg, moved, args.light_offset,
              ctx["mesh_spheres"], 20 * 4 ** args.sphere_subdivisions))
+    if ctx["models"]:
+        print("cycles_reference: %d glTF models imported by Blender, %d materials kept as "
+              "imported (Principled BSDF, %s lobes%s)"
+              % (ctx["models"], ctx["model_materials"], GGX_KIND[0],
+                 ", Specular 0: no dielectric layer (diagnostic)" if args.no_dielectric_specular
+                 else ""))
     if ctx["light_pieces"]:
         print("cycles_reference: scale %g; light triangles cut into %d pieces: Cycles samples "
               "their solid angle (inexactly) only within %.3g scene units of their planes"
