@@ -109,9 +109,14 @@ Supported, and nothing else (anything else stops the script with a message namin
                 Principled BSDFs' Specular to 0, a diagnostic to tell that layer from
                 everything else; Blender 3.4's Principled diffuse is Burley's (Disney)
                 diffuse, which depends on the roughness and darkens at grazing angles,
-                zonetrace's is Lambert's; a glTF metal's Fresnel is Principled's, F0 the
-                base colour (1 for white), zonetrace's is Schlick's with an index of 0.01
-                (F0 0.961)
+                zonetrace's is Lambert's; Cycles multiplies diffuse light by a shadowing
+                term where the shading normal leaves the geometric one (bump_shadowing_term,
+                after Chiang et al. 2019, "Taming the Shadow Terminator"), which darkens a
+                normal-mapped diffuse surface under light from near its geometric horizon
+                (a sky), where zonetrace shades with the mapped normal alone, as glTF
+                does; a glTF metal's Fresnel is Principled's, F0 the base colour (1 for
+                white), zonetrace's is Schlick's with an index of 0.01 (F0 0.961), whose
+                multiple-scattering compensation then differs too
   far light   "sun" {"direction", "irradiance", "angle" (0.53)}: a sun lamp whose strength is the
                 irradiance on a surface facing it (W/m^2, per channel through the lamp colour)
               "sky" {"color"}: the world's background colour (radiance, W/m^2/sr)
