@@ -15,10 +15,11 @@
  * normal. */
 #define MODEL_SLOT_TEXTURES 4
 
-/* The refractive index given to metals: Schlick's term with an index this
- * small is ~1 at every angle, so the base colour is the reflectance, as
- * glTF defines a metal's. */
-#define MODEL_METAL_IOR 0.01
+/* The refractive index given to metals: Schlick's term with index 0 is 1
+ * at every angle, so the base colour is the reflectance, as glTF defines a
+ * metal's at normal incidence.  (0.01 gave F0 = 0.961: model metals were
+ * 4% dark against Cycles.)  Only metals without a refractive lobe take it. */
+#define MODEL_METAL_IOR 0.0
 
 /* Where a file's textures are decoded into: m->textures, their names
  * (each decoded once), room for `capacity`. */
