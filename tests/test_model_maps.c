@@ -16,6 +16,7 @@
  *   cannot be decoded are left out, counted and named, and the render
  *   stays finite. */
 #include "test_support.h"
+#include "ggx_reference.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -95,17 +96,8 @@ static double schlick(double c)
 }
 
 /* GGX with alpha a, in a frame whose z is the normal. */
-static double ggx_d(d3 h, double a)
-{
-    double t = h.z * h.z * (a * a - 1) + 1;
-    return a * a / (PI * t * t);
-}
-
-static double lambda(d3 w, double a)
-{
-    double z2 = w.z * w.z;
-    return 0.5 * (sqrt(1 + a * a * (1 - z2) / z2) - 1);
-}
+static double ggx_d(d3 h, double a) { return ggx_ref_d(h.z, a); }
+static double lambda(d3 w, double a) { return ggx_ref_lambda(w.z, a); }
 
 /* f cos_i of the rough reflector from wo to wi, with Fresnel F(wo.h) or
  * (fresnel 0) without. */

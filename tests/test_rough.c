@@ -5,6 +5,7 @@
  * out here (in double, independently of the renderer), which checks the
  * lobes' values, their densities and the MIS between them and the sun. */
 #include "test_support.h"
+#include "ggx_reference.h"
 #include "fresnel.h"
 
 #include <math.h>
@@ -25,17 +26,8 @@ static d3 scale(d3 a, double s) { return mk(a.x * s, a.y * s, a.z * s); }
 static d3 unit(d3 a) { return scale(a, 1 / sqrt(dot(a, a))); }
 
 /* GGX with alpha a, in a frame whose z is the normal. */
-static double ggx_d(d3 h, double a)
-{
-    double t = h.z * h.z * (a * a - 1) + 1;
-    return a * a / (PI * t * t);
-}
-
-static double lambda(d3 w, double a)
-{
-    double z2 = w.z * w.z;
-    return 0.5 * (sqrt(1 + a * a * (1 - z2) / z2) - 1);
-}
+static double ggx_d(d3 h, double a) { return ggx_ref_d(h.z, a); }
+static double lambda(d3 w, double a) { return ggx_ref_lambda(w.z, a); }
 
 /* f |cos_i| of the white rough interface from wo (z > 0) to wi, without
  * compensation and, for transmission, in energy (no 1/eta^2); eta = 0 is
