@@ -16,6 +16,7 @@
  *   cannot be decoded are left out, counted and named, and the render
  *   stays finite. */
 #include "test_support.h"
+#include "d3.h"
 #include "ggx_reference.h"
 
 #include <math.h>
@@ -29,17 +30,6 @@
 #define PI 3.14159265358979323846
 #define MODELS ZT_SOURCE_DIR "/tests/data/pbr/"
 
-typedef struct { double x, y, z; } d3;
-
-static d3 mk(double x, double y, double z) { d3 r = {x, y, z}; return r; }
-static double dot(d3 a, d3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static d3 add(d3 a, d3 b) { return mk(a.x + b.x, a.y + b.y, a.z + b.z); }
-static d3 scale(d3 a, double s) { return mk(a.x * s, a.y * s, a.z * s); }
-static d3 unit(d3 a) { return scale(a, 1 / sqrt(dot(a, a))); }
-static d3 cross(d3 a, d3 b)
-{
-    return mk(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
 
 /* The code make_pbr_gltf.py writes for a component c in [-1, 1], and the
  * value a reader takes from it. */

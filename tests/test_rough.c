@@ -5,6 +5,7 @@
  * out here (in double, independently of the renderer), which checks the
  * lobes' values, their densities and the MIS between them and the sun. */
 #include "test_support.h"
+#include "d3.h"
 #include "ggx_reference.h"
 #include "fresnel.h"
 
@@ -17,13 +18,6 @@
 
 #define PI 3.14159265358979323846
 
-typedef struct { double x, y, z; } d3;
-
-static d3 mk(double x, double y, double z) { d3 r = {x, y, z}; return r; }
-static double dot(d3 a, d3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static d3 add(d3 a, d3 b) { return mk(a.x + b.x, a.y + b.y, a.z + b.z); }
-static d3 scale(d3 a, double s) { return mk(a.x * s, a.y * s, a.z * s); }
-static d3 unit(d3 a) { return scale(a, 1 / sqrt(dot(a, a))); }
 
 /* GGX with alpha a, in a frame whose z is the normal. */
 static double ggx_d(d3 h, double a) { return ggx_ref_d(h.z, a); }

@@ -18,18 +18,6 @@
 
 #include "util/error.h"
 
-static int get_float(const struct aiMaterial *am, const char *key, unsigned type, unsigned index,
-                     double *out)
-{
-    ai_real v;
-    unsigned n = 1;
-    if (aiGetMaterialFloatArray(am, key, type, index, &v, &n) != aiReturn_SUCCESS || n < 1 ||
-        !isfinite(v))
-        return 0;
-    *out = v;
-    return 1;
-}
-
 /* A map left out: counted, the first one named with the reason. */
 static void fallback(mesh *m, const mesh_slot *s, const char *what, const char *why)
 {
@@ -86,7 +74,7 @@ static int bump_as_normal_map(model_textures *tx, const struct aiMaterial *am, m
     }
     s->normal_texture = k;
     double v;
-    if (get_float(am, "$tex.bumpmult", aiTextureType_HEIGHT, 0, &v))
+    if (model_material_float(am, "$tex.bumpmult", aiTextureType_HEIGHT, 0, &v))
         s->normal_scale = v;
     return 1;
 }
@@ -111,10 +99,10 @@ static void count_unused(const struct aiMaterial *am, int gltf, mesh *m, int bum
      * glTF's specular-glossiness), MTL's Ks. */
     has[MESH_UNUSED_SPECULAR] =
         aiGetMaterialTextureCount(am, aiTextureType_SPECULAR) ||
-        (gltf && get_float(am, AI_MATKEY_SPECULAR_FACTOR, &v)) ||
+        (gltf && model_material_float(am, AI_MATKEY_SPECULAR_FACTOR, &v)) ||
         (!gltf && aiGetMaterialColor(am, AI_MATKEY_COLOR_SPECULAR, &c) == aiReturn_SUCCESS &&
          (c.r > 0 || c.g > 0 || c.b > 0));
-    has[MESH_UNUSED_CLEARCOAT] = (get_float(am, AI_MATKEY_CLEARCOAT_FACTOR, &v) && v > 0) ||
+    has[MESH_UNUSED_CLEARCOAT] = (model_material_float(am, AI_MATKEY_CLEARCOAT_FACTOR, &v) && v > 0) ||
                                  aiGetMaterialTextureCount(am, aiTextureType_CLEARCOAT);
     has[MESH_UNUSED_SHEEN] =
         (aiGetMaterialColor(am, AI_MATKEY_SHEEN_COLOR_FACTOR, &c) == aiReturn_SUCCESS &&
@@ -178,7 +166,7 @@ zt_status model_maps(model_textures *tx, const struct aiMaterial *am, int gltf, 
                          &st, err);
         if (k >= 0) {
             s->rough_map = (mesh_map){k, 0};
-            if (!get_float(am, AI_MATKEY_ROUGHNESS_FACTOR, &v))
+            if (!model_material_float(am, AI_MATKEY_ROUGHNESS_FACTOR, &v))
                 s->roughness = 1.0;
         }
         k = st == ZT_OK ? find_map(tx, am, aiTextureType_METALNESS, "metal map (map_Pm)", s, &st,
@@ -186,7 +174,7 @@ zt_status model_maps(model_textures *tx, const struct aiMaterial *am, int gltf, 
                         : -1;
         if (k >= 0) {
             s->metal_map = (mesh_map){k, 0};
-            if (!get_float(am, AI_MATKEY_METALLIC_FACTOR, &v))
+            if (!model_material_float(am, AI_MATKEY_METALLIC_FACTOR, &v))
                 s->metallic = 1.0;
         }
     }
@@ -194,8 +182,8 @@ zt_status model_maps(model_textures *tx, const struct aiMaterial *am, int gltf, 
     if (k >= 0) {
         s->normal_texture = k;
         /* glTF's normalTexture.scale; MTL's -bm. */
-        if (get_float(am, "$tex.scale", aiTextureType_NORMALS, 0, &v) ||
-            get_float(am, "$tex.bumpmult", aiTextureType_NORMALS, 0, &v))
+        if (model_material_float(am, "$tex.scale", aiTextureType_NORMALS, 0, &v) ||
+            model_material_float(am, "$tex.bumpmult", aiTextureType_NORMALS, 0, &v))
             s->normal_scale = v;
     }
     int bump_unused = 0;

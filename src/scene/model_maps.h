@@ -5,11 +5,26 @@
 #ifndef ZT_SCENE_MODEL_MAPS_H
 #define ZT_SCENE_MODEL_MAPS_H
 
+#include <math.h>
 #include <stddef.h>
 
 #include <assimp/material.h>
 
 #include "scene/mesh.h"
+
+/* A material's float `key` (texture type and index as Assimp keys them)
+ * into *out; 0 when the file has none or it is not finite. */
+static inline int model_material_float(const struct aiMaterial *am, const char *key, unsigned type,
+                                       unsigned index, double *out)
+{
+    ai_real v;
+    unsigned n = 1;
+    if (aiGetMaterialFloatArray(am, key, type, index, &v, &n) != aiReturn_SUCCESS || n < 1 ||
+        !isfinite(v))
+        return 0;
+    *out = v;
+    return 1;
+}
 
 /* The most textures one slot decodes: base colour, roughness, metal,
  * normal. */
@@ -17,8 +32,8 @@
 
 /* The refractive index given to metals: Schlick's term with index 0 is 1
  * at every angle, so the base colour is the reflectance, as glTF defines a
- * metal's at normal incidence.  (0.01 gave F0 = 0.961: model metals were
- * 4% dark against Cycles.)  Only metals without a refractive lobe take it. */
+ * metal's at normal incidence.  Only metals without a refractive lobe
+ * take it (a scene file's index must be positive). */
 #define MODEL_METAL_IOR 0.0
 
 /* Where a file's textures are decoded into: m->textures, their names

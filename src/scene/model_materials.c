@@ -34,18 +34,6 @@ static double clamp01(double x)
     return isfinite(x) ? (x < 0.0 ? 0.0 : x > 1.0 ? 1.0 : x) : 0.0;
 }
 
-static int get_float(const struct aiMaterial *am, const char *key, unsigned type, unsigned index,
-                     double *out)
-{
-    ai_real v;
-    unsigned n = 1;
-    if (aiGetMaterialFloatArray(am, key, type, index, &v, &n) != aiReturn_SUCCESS || n < 1 ||
-        !isfinite(v))
-        return 0;
-    *out = v;
-    return 1;
-}
-
 static int get_color(const struct aiMaterial *am, const char *key, unsigned type, unsigned index,
                      vec3 *out)
 {
@@ -250,22 +238,22 @@ static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_sl
 
     double metallic = 0.0, transmission = 0.0, ior = GLASS_IOR, v;
     int thin = 0;
-    if (get_float(am, AI_MATKEY_METALLIC_FACTOR, &v))
+    if (model_material_float(am, AI_MATKEY_METALLIC_FACTOR, &v))
         metallic = clamp01(v);
-    if (get_float(am, AI_MATKEY_TRANSMISSION_FACTOR, &v)) {
+    if (model_material_float(am, AI_MATKEY_TRANSMISSION_FACTOR, &v)) {
         transmission = clamp01(v);
         /* glTF: transmission without a volume's thickness is thin-walled. */
-        thin = !(get_float(am, AI_MATKEY_VOLUME_THICKNESS_FACTOR, &v) && v > 0.0);
+        thin = !(model_material_float(am, AI_MATKEY_VOLUME_THICKNESS_FACTOR, &v) && v > 0.0);
     }
     /* MTL's dissolve and IFC's transparency arrive as opacity: see-through
      * surfaces, not refracting solids, so panes (the thing behind is seen
      * undistorted).  glTF's base-colour alpha arrives there too, but means
      * coverage (alpha blending), not glass: ignored. */
-    else if (!gltf && get_float(am, AI_MATKEY_OPACITY, &v)) {
+    else if (!gltf && model_material_float(am, AI_MATKEY_OPACITY, &v)) {
         transmission = 1.0 - clamp01(v);
         thin = 1;
     }
-    if (get_float(am, AI_MATKEY_REFRACTI, &v) && v >= 1.0 && v <= 4.0)
+    if (model_material_float(am, AI_MATKEY_REFRACTI, &v) && v >= 1.0 && v <= 4.0)
         ior = v;
     s->metallic = metallic;
     s->transmission = transmission;
@@ -283,7 +271,7 @@ static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_sl
     vec3 e = v3(0, 0, 0);
     if (get_color(am, AI_MATKEY_COLOR_EMISSIVE, &e)) {
         double k = 1.0;
-        if (get_float(am, AI_MATKEY_EMISSIVE_INTENSITY, &v) && v >= 0.0)
+        if (model_material_float(am, AI_MATKEY_EMISSIVE_INTENSITY, &v) && v >= 0.0)
             k = v;
         e = v3(fmax(e.x, 0.0) * k, fmax(e.y, 0.0) * k, fmax(e.z, 0.0) * k);
         if (isfinite(e.x) && isfinite(e.y) && isfinite(e.z))
@@ -291,12 +279,12 @@ static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_sl
     }
     /* glTF's roughness factor (default 1: a material that gives none is
      * rough), onto the metallic and refractive lobes (diffuse has none). */
-    if (get_float(am, AI_MATKEY_ROUGHNESS_FACTOR, &v))
+    if (model_material_float(am, AI_MATKEY_ROUGHNESS_FACTOR, &v))
         s->roughness = clamp01(v);
     /* MTL without Pr: the Phong exponent Ns.  Beckmann's alpha for a Phong
      * lobe of exponent n is sqrt(2 / (n + 2)) (Walter et al. 2007), GGX's
      * alpha is taken equal to it, and alpha = roughness^2. */
-    else if (obj && get_float(am, AI_MATKEY_SHININESS, &v) && v >= 0.0)
+    else if (obj && model_material_float(am, AI_MATKEY_SHININESS, &v) && v >= 0.0)
         s->roughness = clamp01(pow(2.0 / (v + 2.0), 0.25));
     s->mat.roughness = s->roughness;
     s->texture = -1;
