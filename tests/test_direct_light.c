@@ -98,9 +98,22 @@ static void assert_splits_see_all(const direct_ctx *c, int light, vec3 x, vec3 n
 {
     double exact = direct_irradiance(c, light, x, n, receiver);
     assert_true(exact > 0);
-    for (int s = 1; s <= DIRECT_SPLITS; s++)
-        assert_true(fabs(direct_irradiance_split(c, light, x, n, receiver, s) - exact) <=
-                    1e-9 * exact);
+    for (int j = 1; j <= 3; j++)
+        for (int i = 0; i < 1 << (2 * j); i++)
+            assert_true(fabs(direct_irradiance_split(c, light, x, n, receiver,
+                                                     DIRECT_SPLIT(j, i)) -
+                             exact) <= 1e-9 * exact);
+}
+
+/* The mean of the 4^levels points of a block that share one point's rays,
+ * all at x. */
+static double split_mean(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver, int levels)
+{
+    int count = 1 << (2 * levels);
+    double mean = 0;
+    for (int i = 0; i < count; i++)
+        mean += direct_irradiance_split(c, light, x, n, receiver, DIRECT_SPLIT(levels, i)) / count;
+    return mean;
 }
 
 static void test_query_stops_past_max(void **state)
@@ -140,7 +153,7 @@ static void test_splits_share_the_rays(void **state)
     vec3 up = v3(0, 1, 0);
 
     /* Under the comb: seen by rays.  Points across one tooth's shadow. */
-    double worst_split = 0, worst_one = 0, worst_fine = 0;
+    double worst_split = 0, worst_one = 0, worst_fine = 0, worst_block[3] = {0, 0, 0};
     int points = 0;
     for (int i = 0; i < 8; i++) {
         vec3 x = v3(0.01 + 0.025 * i, 0, 0.02 + 0.01 * i);
@@ -149,20 +162,25 @@ static void test_splits_share_the_rays(void **state)
         double ref = direct_irradiance(&fine, light, x, up, floor_part);
         double ref_kept = direct_irradiance(&kept, light, x, up, floor_part);
         worst_fine = fmax(worst_fine, fabs(ref_kept - ref) / ref);
-        double mean = 0;
-        for (int s = 1; s <= DIRECT_SPLITS; s++)
-            mean += direct_irradiance_split(c, light, x, up, floor_part, s) / DIRECT_SPLITS;
         assert_true(ref > 0);
-        worst_split = fmax(worst_split, fabs(mean - ref) / ref);
         worst_one = fmax(worst_one, fabs(one - ref) / ref);
-        /* The four quarters see the centres one point sees; they differ
-         * only by the weights of the quarters within a piece. */
-        assert_true(fabs(mean - one) <= 0.02 * one);
+        /* A block of 4, 16 or 64 points sees the centres one point sees;
+         * they differ only by the weights of the centres within a piece (a
+         * block of 64 takes the whole triangle as its piece). */
+        for (int j = 1; j <= 3; j++) {
+            double mean = split_mean(c, light, x, up, floor_part, j);
+            worst_split = fmax(worst_split, fabs(mean - ref) / ref);
+            worst_block[j - 1] = fmax(worst_block[j - 1], fabs(mean - one) / one);
+        }
         points++;
     }
-    printf("%d points under the comb: one point %.2f%%, four splits %.2f%% from the fine "
-           "reference at worst; one 4 times coarser %.2f%% from it\n",
-           points, 100 * worst_one, 100 * worst_split, 100 * worst_fine);
+    printf("%d points under the comb: one point %.2f%%, blocks of 4/16/64 splits %.2f%% from "
+           "the fine reference at worst (%.2f%% / %.2f%% / %.2f%% from the one point); one 4 "
+           "times coarser %.2f%% from it\n",
+           points, 100 * worst_one, 100 * worst_split, 100 * worst_block[0],
+           100 * worst_block[1], 100 * worst_block[2], 100 * worst_fine);
+    for (int j = 0; j < 3; j++)
+        assert_true(worst_block[j] <= 0.03);
     assert_true(worst_split < 0.10);
     assert_true(worst_fine < 0.05); /* 2.1% measured: the pieces' size */
 
@@ -179,9 +197,7 @@ static void test_splits_share_the_rays(void **state)
     double exact = direct_irradiance(c, light, x, up, floor_part);
     vec3 tri[3] = {v3(-2, 10, -2), v3(2, 10, -2), v3(0, 10, 2)};
     double open = lambert_polygon(x, up, tri, 3); /* the light unhidden */
-    double mean = 0;
-    for (int s = 1; s <= DIRECT_SPLITS; s++)
-        mean += direct_irradiance_split(c, light, x, up, floor_part, s) / DIRECT_SPLITS;
+    double mean = split_mean(c, light, x, up, floor_part, 1);
     printf("at the comb's edge: unhidden %.5g, exact %.5g, split points by rays %.5g (%.2f%%)\n",
            open, exact, mean, 100 * fabs(mean - exact) / exact);
     assert_true(exact > 0.5 * open && exact < 0.99 * open);

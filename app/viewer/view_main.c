@@ -544,8 +544,14 @@ static void draw_hud(viewer *v, uint32_t *px, int pitch, double now)
     else
         snprintf(level, sizeof level, "level %d", req.level);
     int depth = req.level > req.depth ? req.level : req.depth;
-    snprintf(lines[n++], sizeof lines[0], "%s  %s  depth %d",
-             v->shown.method == ZT_METHOD_ZONE ? "zone" : "path", level, depth);
+    char preview[48] = "";
+    if (v->shown.method == ZT_METHOD_ZONE && v->shown.preview)
+        snprintf(preview, sizeof preview, v->shown.preview > 1 ? "  preview 1/%d" : "  preview",
+                 v->shown.preview);
+    else if (v->shown.method == ZT_METHOD_ZONE)
+        snprintf(preview, sizeof preview, "  full image");
+    snprintf(lines[n++], sizeof lines[0], "%s  %s  depth %d%s",
+             v->shown.method == ZT_METHOD_ZONE ? "zone" : "path", level, depth, preview);
     snprintf(lines[n++], sizeof lines[0], "EV %+.1f %s", current_exposure(v),
              v->exposure_fixed ? "fixed" : "auto");
     if (v->motions)

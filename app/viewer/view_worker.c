@@ -55,43 +55,65 @@ typedef struct wstate {
     double ev_time;
     int ev_stale;
     int ev_spp;            /* samples per pixel when it was computed */
-    int zone_preview;      /* zone: next frame at half resolution (moving) */
-    zt_image *small;       /* the half-resolution frame */
+    int zone_preview;      /* zone: next frame a preview (moving) */
+    int preview_div;       /* its resolution's divisor: 1, 2 or 4 */
+    int preview_shown;     /* the picture shown is a preview at 1/this
+                              resolution; 0: a full image */
+    zt_image *small;       /* a preview at a lower resolution */
 } wstate;
 
-/* Zone mode while the camera moves: Phase Two at half the resolution,
- * shown enlarged, then the full frame once the camera rests.  Returns the
- * status of the render. */
+/* Zone mode while the camera moves: the zone tracer's preview (one sample
+ * a pixel from the forest's nodes, zt_renderer_preview), at the full
+ * resolution while it fits in a frame period, else at 1/2 or 1/4 of it and
+ * shown enlarged; the full image follows once the camera rests.  Returns
+ * the status of the render. */
 static zt_status zone_preview_frame(wstate *s, zt_render_stats *stats, zt_error *err)
 {
-    int w = s->sum->width, h = s->sum->height;
-    int sw = w > 1 ? w / 2 : 1, sh = h > 1 ? h / 2 : 1;
-    if (!s->small || s->small->width != sw || s->small->height != sh) {
-        zt_image_release(s->small);
-        s->small = zt_image_create(sw, sh);
-        if (!s->small)
-            return ZT_ERR_MEMORY;
-    }
-    zt_camera cam = s->req.camera;
-    zt_status st = zt_camera_set_resolution(&cam, sw, sh, err);
-    if (st == ZT_OK)
-        st = zt_renderer_set_camera(s->r, &cam, err);
-    if (st != ZT_OK)
-        return st;
-    memset(s->small->pixels, 0, (size_t)sw * sh * 3 * sizeof(float));
-    st = zt_renderer_accumulate(s->r, 0, 1, s->small, stats, err);
-    zt_error ignored;
-    zt_renderer_set_camera(s->r, &s->req.camera, &ignored);
-    if (st != ZT_OK)
-        return st;
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            const float *src = zt_image_pixel(s->small, x * sw / w, y * sh / h);
-            float *dst = zt_image_pixel(s->sum, x, y);
-            dst[0] = src[0];
-            dst[1] = src[1];
-            dst[2] = src[2];
+    int w = s->sum->width, h = s->sum->height, div = s->preview_div > 1 ? s->preview_div : 1;
+    int sw = w / div > 1 ? w / div : 1, sh = h / div > 1 ? h / div : 1;
+    double t0 = view_now();
+    zt_status st;
+    if (div == 1) {
+        memset(s->sum->pixels, 0, (size_t)w * h * 3 * sizeof(float));
+        st = zt_renderer_preview(s->r, s->sum, stats, err);
+    } else {
+        if (!s->small || s->small->width != sw || s->small->height != sh) {
+            zt_image_release(s->small);
+            s->small = zt_image_create(sw, sh);
+            if (!s->small)
+                return ZT_ERR_MEMORY;
         }
+        zt_camera cam = s->req.camera;
+        st = zt_camera_set_resolution(&cam, sw, sh, err);
+        if (st == ZT_OK)
+            st = zt_renderer_set_camera(s->r, &cam, err);
+        if (st != ZT_OK)
+            return st;
+        memset(s->small->pixels, 0, (size_t)sw * sh * 3 * sizeof(float));
+        st = zt_renderer_preview(s->r, s->small, stats, err);
+        zt_error ignored;
+        zt_renderer_set_camera(s->r, &s->req.camera, &ignored);
+        if (st == ZT_OK)
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) {
+                    const float *src = zt_image_pixel(s->small, x * sw / w, y * sh / h);
+                    float *dst = zt_image_pixel(s->sum, x, y);
+                    dst[0] = src[0];
+                    dst[1] = src[1];
+                    dst[2] = src[2];
+                }
+    }
+    if (st != ZT_OK)
+        return st;
+    /* The next preview's scale: a quarter of the pixels when this one
+     * took more than a frame period, four times as many when that would
+     * still take less than half of one. */
+    double dt = view_now() - t0, frame = s->w->cfg.frame_seconds;
+    if (dt > frame && div < 4)
+        s->preview_div = div * 2;
+    else if (div > 1 && 4.0 * dt < 0.5 * frame)
+        s->preview_div = div / 2;
+    s->preview_shown = div;
     return ZT_OK;
 }
 
@@ -279,6 +301,7 @@ static void publish(wstate *s, double batch_seconds)
     f->method = s->method;
     f->auto_exposure = s->auto_ev;
     f->batch_seconds = batch_seconds;
+    f->preview = s->method == ZT_METHOD_ZONE ? s->preview_shown : 0;
     pthread_mutex_unlock(&sh->lock);
     s->last_publish = now;
 
@@ -387,6 +410,7 @@ static void *worker_main(void *arg)
         }
         if (s.method == ZT_METHOD_ZONE)
             memset(s.sum->pixels, 0, (size_t)s.sum->width * (size_t)s.sum->height * 3 * sizeof(float));
+        s.preview_shown = 0;
         st = zt_renderer_accumulate(s.r, s.spp, 1, s.sum, &stats, &err);
         double dt = view_now() - t0;
         if (st == ZT_ERR_CANCELLED) {

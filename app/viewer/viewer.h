@@ -115,6 +115,8 @@ typedef struct view_frame {
     int method;              /* what rendered it */
     double auto_exposure;    /* EV the automatic exposure picked */
     double batch_seconds;    /* the last batch's time */
+    int preview;             /* zone: a preview at 1/preview of the
+                                resolution (moving); 0: the full image */
 } view_frame;
 
 typedef struct view_shared {

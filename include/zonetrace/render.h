@@ -198,6 +198,16 @@ zt_status zt_renderer_accumulate(zt_renderer *renderer, int first_sample,
                                  int count, zt_image *sum,
                                  zt_render_stats *stats, zt_error *err);
 
+/* Adds a quick image of the renderer's camera to sum (an image of the
+ * camera's size), for a camera that is moving.  Zone tracer: one sample per
+ * pixel at its centre, every level of light read from the forest's nodes
+ * (no exact direct light, no gathers, no edge coverage): about one ray a
+ * pixel, with shadows as soft as the nodes' spacing and aliased edges.
+ * Path tracer: sample 0 of every pixel, as zt_renderer_accumulate(0, 1).
+ * Cancelled through the progress callback like an image. */
+zt_status zt_renderer_preview(zt_renderer *renderer, zt_image *sum,
+                              zt_render_stats *stats, zt_error *err);
+
 /* Renders the renderer's camera into a new linear image (*out, the
  * caller's) as zt_render does: the image is the same, bit for bit, as
  * zt_render of the scene with this camera and these options (path tracer:

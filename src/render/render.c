@@ -179,6 +179,25 @@ zt_status zt_renderer_accumulate(zt_renderer *r, int first, int count, zt_image 
     return st;
 }
 
+zt_status zt_renderer_preview(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
+                              zt_error *err)
+{
+    if (r->options.method == ZT_METHOD_PATH)
+        return zt_renderer_accumulate(r, 0, 1, sum, stats, err);
+    zt_render_stats local;
+    if (!stats)
+        stats = &local;
+    if (sum->width != r->scene->camera.width || sum->height != r->scene->camera.height)
+        return zt_fail(err, ZT_ERR_ARGUMENT, "preview image is %dx%d, the camera %dx%d",
+                       sum->width, sum->height, r->scene->camera.width,
+                       r->scene->camera.height);
+    double t0 = render_clock();
+    zt_status st = zone_preview(r, sum, stats, err);
+    stats->seconds = render_clock() - t0;
+    stats->trace_seconds = stats->seconds;
+    return st;
+}
+
 /* One image of the renderer's camera; t0 is when its time limit started. */
 static zt_status renderer_render(zt_renderer *r, double t0, zt_image **out,
                                  zt_render_stats *stats, zt_error *err)

@@ -84,6 +84,8 @@ zt_status path_accumulate(zt_renderer *r, int first, int count, zt_image *sum,
 zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err);
 zt_status zone_accumulate(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
                           zt_error *err);
+/* One sample per pixel from the forest's nodes (phase_two/preview.c). */
+zt_status zone_preview(zt_renderer *r, zt_image *sum, zt_render_stats *stats, zt_error *err);
 void zone_release(zt_renderer *r);
 /* Why Phase One built fewer levels than asked (a zt_stop_reason). */
 int zone_stop_reason(const zt_renderer *r);

@@ -212,6 +212,11 @@ typedef struct zone_trace {
 /* Irradiance of level `level` at point x (normal n) on side `side` of
  * primitive prim, read from the nodes. */
 vec3 zone_map_read(const zone_forest *f, const rscene *rs, int level, int prim, int side, vec3 x);
+/* e plus the irradiance of levels first..last at x, added level by level (the
+ * same sums as that many zone_map_read calls), the nodes' weights found
+ * once. */
+vec3 zone_map_read_levels(const zone_forest *f, const rscene *rs, int first, int last, int prim,
+                          int side, vec3 x, vec3 e);
 /* The same from the light by way of specular surfaces alone (f->c; 0
  * where it is not kept apart). */
 vec3 zone_specular_map_read(const zone_forest *f, const rscene *rs, int level, int prim,

@@ -145,6 +145,31 @@ zt_status zone_accumulate(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
     return phase_two(r, sum, stats, 0, err);
 }
 
+zt_status zone_preview(zt_renderer *r, zt_image *sum, zt_render_stats *stats, zt_error *err)
+{
+    zone_forest *f = (zone_forest *)r->forest;
+    const zt_render_options *o = &r->options;
+    double t0 = render_clock();
+    p2_ctx c;
+    memset(&c, 0, sizeof c);
+    c.r = r;
+    c.f = f;
+    cam_init(&c.c, &r->scene->camera);
+    c.lo = o->level >= 0 ? o->level : 0;
+    c.hi = o->level >= 0 ? o->level : o->depth;
+    uint64_t rays = 0;
+    zt_status st = p2_render_preview(&c, sum, &rays, err);
+    if (stats) {
+        stats->threads = render_thread_count(o->threads);
+        stats->rays = rays;
+        stats->samples = (uint64_t)sum->width * sum->height;
+        stats->phase_one_seconds = 0.0;
+        stats->phase_two_seconds = render_clock() - t0;
+        fill_forest_stats(f, r, stats);
+    }
+    return st;
+}
+
 zt_status zone_accumulate_reference(zt_renderer *r, zt_image *sum, zt_error *err)
 {
     if (r->options.method != ZT_METHOD_ZONE || !r->forest)

@@ -498,13 +498,39 @@ static int clips_every_point(const direct_ctx *c)
 /* Pieces whose rays' results by_rays keeps, to weigh the smaller side. */
 #define BY_RAYS_KEPT 1024
 
+/* The centre of the sub-piece of triangle q that split point `index`
+ * names at `levels` levels (direct.h): each base-4 digit, lowest first,
+ * takes the quarter at corner d (d < 3) or the middle one (d = 3). */
+static vec3 split_centre(const vec3 q[3], int levels, int index)
+{
+    vec3 a = q[0], b = q[1], c = q[2];
+    for (int l = 0; l < levels; l++, index >>= 2) {
+        int d = index & 3;
+        vec3 ab = v3_scale(v3_add(a, b), 0.5), bc = v3_scale(v3_add(b, c), 0.5),
+             ca = v3_scale(v3_add(c, a), 0.5);
+        if (d == 0) {
+            b = ab;
+            c = ca;
+        } else if (d == 1) {
+            a = ab;
+            c = bc;
+        } else if (d == 2) {
+            a = ca;
+            b = bc;
+        } else {
+            a = ab;
+            b = bc;
+            c = ca;
+        }
+    }
+    return v3_scale(v3_add(v3_add(a, b), c), 1.0 / 3.0);
+}
+
 /* The irradiance of polygon piece p (on the light's plane) at x, with
  * visibility by rays: p is cut into triangles of about 1/count of the
- * light each, and each counts if a ray from x reaches its centre.  With
- * split s in 1..4 the triangles are four times as large and the ray goes to
- * the centre of their quarter s (corner s, or the middle for 4): four
- * points with splits 1..4 side by side see, between them, the centres of the
- * finer triangles. */
+ * light each, and each counts if a ray from x reaches its centre.  A split
+ * point (direct.h) takes triangles 4^j times as large and sends its ray to
+ * the centre of the sub-piece it names. */
 static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, const poly2 *p,
                     vec3 x, vec3 n, int count, int split)
 {
@@ -512,10 +538,10 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
     int fan = p->n - 2, k = 0;
     while (fan * (1 << (2 * k)) < count && k < 6)
         k++;
-    if (k == 0)
-        split = 0;
-    if (split)
-        k--;
+    int levels = split ? split >> 16 : 0, index = split ? (split & 0xffff) - 1 : 0;
+    if (levels > k)
+        levels = k;
+    k -= levels;
     int m = 1 << k, pieces = fan * m * m;
     vec3f xo = ray_offset(v3_to_f3(x), v3_to_f3(n));
     /* First every piece's ray; then Lambert's formula over the seen pieces
@@ -530,11 +556,7 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
     vec3 q[3];
     fan_start(&w, f, p, m);
     while (fan_next(&w, q)) {
-        vec3 ctr = v3_scale(v3_add(v3_add(q[0], q[1]), q[2]), 1.0 / 3.0);
-        if (split >= 1 && split <= 3)
-            /* (4 q_s + the other two) / 6: the centre of the quarter at
-             * corner s. */
-            ctr = v3_add(v3_scale(ctr, 0.5), v3_scale(q[split - 1], 0.5));
+        vec3 ctr = split_centre(q, levels, index);
         vec3f to = f3_sub(v3_to_f3(ctr), xo);
         float dist = f3_length(to);
         vec3f s = f3_splat(0.0f);

@@ -379,6 +379,29 @@ vec3 zone_map_read(const zone_forest *f, const rscene *rs, int level, int prim, 
     return map_read(f, f->e, rs, level, prim, side, x);
 }
 
+vec3 zone_map_read_levels(const zone_forest *f, const rscene *rs, int first, int last, int prim,
+                          int side, vec3 x, vec3 e)
+{
+    if (!f->e || first < 0)
+        return e;
+    if (last >= f->map_levels)
+        last = f->map_levels - 1;
+    if (first > last)
+        return e;
+    int32_t node[4];
+    float w[4];
+    int n = surface_nodes_weights(&f->sn, rs, prim, side, x, node, w);
+    for (int level = first; level <= last; level++) {
+        vec3 acc = v3(0, 0, 0);
+        for (int k = 0; k < n; k++) {
+            const float *v = f->e + ((size_t)level * (size_t)f->sn.node_count + (size_t)node[k]) * 3;
+            acc = v3_add(acc, v3_scale(v3(v[0], v[1], v[2]), w[k]));
+        }
+        e = v3_add(e, acc);
+    }
+    return e;
+}
+
 vec3 zone_specular_map_read(const zone_forest *f, const rscene *rs, int level, int prim,
                             int side, vec3 x)
 {

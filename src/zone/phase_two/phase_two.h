@@ -171,6 +171,9 @@ void p2_reference(const p2_ctx *c, zone_trace *t, const p2_pixel *px, double acc
 /* The strategies (phase_two_render.c): add the image to sum. */
 zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays, zt_error *err);
 zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays, zt_error *err);
+/* The preview (preview.c): one sample per pixel, shaded from the nodes. */
+zt_status p2_render_preview(const p2_ctx *c, zt_image *sum, uint64_t *rays, zt_error *err);
+
 zt_status p2_render_reference(const p2_ctx *c, zt_image *sum, uint64_t *rays, zt_error *err);
 
 /* For tests: renders r's image into sum with the reference shading above

@@ -92,18 +92,22 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
 
     if (m->weight[LOBE_DIFFUSE] > 0.0f && !(flags & ZR_SKIP_DIFFUSE)) {
         vec3 e = v3(0, 0, 0);
-        for (int l = lo > 1 ? lo : 1; l <= hi; l++) {
-            if (l == 1 && exact_direct) {
-                /* Exact direct light from the lights, and the sky's. */
-                e = v3_add(e, zone_lights_at(t, h.part, x, n));
-                if (t->f->sky)
-                    e = v3_add(e, zone_sky_irradiance(t, x, n));
-            } else if (exact_direct && zone_gathers(rs, h.part)) {
+        int l = lo > 1 ? lo : 1;
+        if (l == 1 && exact_direct) {
+            /* Exact direct light from the lights, and the sky's. */
+            e = v3_add(e, zone_lights_at(t, h.part, x, n));
+            if (t->f->sky)
+                e = v3_add(e, zone_sky_irradiance(t, x, n));
+            l++;
+        }
+        if (exact_direct && zone_gathers(rs, h.part)) {
+            for (; l <= hi; l++) {
                 e = v3_add(e, zone_gather_irradiance(t, xf, nf, n, l - 1));
                 e = v3_add(e, zone_specular_map_read(t->f, rs, l - 1, h.part, back, x));
-            } else {
-                e = v3_add(e, zone_map_read(t->f, rs, l - 1, h.part, back, x));
             }
+        } else if (l <= hi) {
+            /* The maps of the remaining levels, read at once. */
+            e = zone_map_read_levels(t->f, rs, l - 1, hi - 1, h.part, back, x, e);
         }
         out = v3_add(out, v3_scale(v3_mul(color, e), m->weight[LOBE_DIFFUSE] / 3.14159265358979));
     }

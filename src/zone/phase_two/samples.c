@@ -36,14 +36,19 @@
 #define CURVED_GRID 2  /* sub-pixel grid of smooth pixels that see a sphere */
 /* and of those that may hold a mesh's sub-pixel detail (fine_detail): one
  * mesh is one signature, so its own detail (a stack of fins) shows no
- * edge, and a few samples alias it.  Each 2 x 2 block of these samples
- * shares one point's rays of direct light (direct_irradiance_split, by
- * rays in any scene of more than 48 primitives): on the engine
- * room at 512 x 512, depth 3, 4 x 4 samples each with their own rays gave
- * 1.64% per pixel in 6.4 s of Phase Two, 8 x 8 with their own 1.47% in
- * 24 s (without the occluder search's early stop), 8 x 8 sharing 1.47% in
- * 8.8 s. */
+ * edge, and a few samples alias it.  The pixel's samples share one point's
+ * rays of direct light (direct_irradiance_split, by rays in any scene of
+ * more than 48 primitives), each taking one of the pieces' centres that
+ * point would see: the samples are there to find the mesh's gaps, and the
+ * pixel's mean sees as many points of the light as one sample alone.  On
+ * the engine room at 512 x 512, depth 3: 4 x 4 samples each with their own
+ * rays gave 1.64% per pixel in 6.4 s of Phase Two, 8 x 8 with their own
+ * 1.47% in 24 s (without the occluder search's early stop), 8 x 8 sharing by
+ * 2 x 2 blocks 1.47% in 8.8 s; sharing by the whole pixel (8 x 8, the
+ * default) takes 40% less time than by 2 x 2 blocks, for 0.859% -> 0.871%
+ * per pixel (1,024-spp reference, its noise taken out; BENCHMARKS.md). */
 #define DETAIL_GRID 8
+#define DETAIL_SPLIT 3 /* log2(DETAIL_GRID) */
 /* Specular steps a signature follows.  Fixed, not the render's depth: the
  * images of levels 0..D must use the same samples as the depth-D image,
  * or they would not add up to it. */
@@ -225,10 +230,21 @@ static int push_lights(p2_row *row, const seen_lights *s)
     return 1;
 }
 
+/* Sample (sx, sy)'s point in its 2^levels x 2^levels block (direct.h):
+ * base-4 digits, lowest first, each its cell in the 2 x 2 of one level. */
+static int split_index(int sx, int sy, int levels)
+{
+    int index = 0;
+    for (int l = 0; l < levels; l++)
+        index |= (((sx >> l) & 1) + 2 * ((sy >> l) & 1)) << (2 * l);
+    return index;
+}
+
 /* Pushes pixel (px, py)'s g x g samples while they all have signature
  * `first`; sets *edge when one does not, *curved when one meets a sphere.
- * With `split` each 2 x 2 block of samples shares the rays of one point's
- * direct light (direct_irradiance_split).  Returns 0 when out of memory. */
+ * With `split` levels, each 2^split x 2^split block of samples shares the
+ * rays of one point's direct light (direct_irradiance_split).  Returns 0
+ * when out of memory. */
 static int grid_samples(const p2_ctx *c, int px, int py, int g, int split, uint32_t first,
                         seen_lights *lights, p2_row *row, uint64_t *rays, int *edge, int *curved)
 {
@@ -241,7 +257,7 @@ static int grid_samples(const p2_ctx *c, int px, int py, int g, int split, uint3
             if (ray_signature(rs, org, dir, rays, &h, curved, NULL) != first)
                 *edge = 1;
             note_light(rs, lights, h.part);
-            int ls = split ? 1 + (sx & 1) + 2 * (sy & 1) : 0;
+            int ls = split ? DIRECT_SPLIT(split, split_index(sx, sy, split)) : 0;
             if (!*edge &&
                 !push_sample(rs, row, org, dir, h, 1.0 / (g * g), ls,
                              gather_slot(c, px, py, sy * g + sx, g * g)))
@@ -475,7 +491,7 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
     if (!edge && !marked && g < DETAIL_GRID &&
         fine_detail(c, ct, row->samples + start, row->sample_count - start)) {
         row->sample_count = start;
-        if (!grid_samples(c, px, py, DETAIL_GRID, 1, first, lights, row, rays, &edge,
+        if (!grid_samples(c, px, py, DETAIL_GRID, DETAIL_SPLIT, first, lights, row, rays, &edge,
                           &curved))
             return 0;
     }
