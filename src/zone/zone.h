@@ -7,6 +7,7 @@
 
 #include <stdint.h>
 
+#include "geom/hit.h"
 #include "render/render_internal.h"
 #include "light/distant.h"
 #include "zone/light/direct.h"
@@ -207,7 +208,26 @@ typedef struct zone_trace {
      * the way takes in another set of numbers (rough.c); 0: none. */
     int rough_nested;
     double rough_j;
+    /* Set by a gather for the next ray zone_radiance traces: its first hit,
+     * already found (zone_radiance resets it); NULL: trace it. */
+    const hit *first_hit;
+    /* The gathers' first hits of the pixel being shaded, kept for its next
+     * level's terms (the pixel strategy's; NULL: none kept). */
+    struct zone_gather_memo *memo;
 } zone_trace;
+
+/* A pixel's gathered rays' first hits: its level-2 and level-3 terms gather
+ * along the same directions from the same samples (gather.c), so the second
+ * takes the first's hits instead of tracing them again. */
+#define ZONE_MEMO_SAMPLES 288 /* at least P2_MAX_PIXEL_SAMPLES */
+#define ZONE_MEMO_HITS 1024
+typedef struct zone_gather_memo {
+    uint32_t pixel;                     /* whose samples; UINT32_MAX: none */
+    uint8_t have[ZONE_MEMO_SAMPLES];    /* a sample's hits are kept */
+    vec3f origin[ZONE_MEMO_SAMPLES];    /* from where (a gather elsewhere on
+                                           its specular chain differs) */
+    hit hits[ZONE_MEMO_HITS];
+} zone_gather_memo;
 
 /* Irradiance of level `level` at point x (normal n) on side `side` of
  * primitive prim, read from the nodes. */

@@ -19,6 +19,9 @@
  * reference in 37 s; gathering levels 2 and 3, 0.894% in 16.8 s, since the
  * mesh's nodes can then take a quarter of the cut limit (phase_one.c). */
 
+#include <string.h>
+
+#include "geom/accel.h"
 #include "geom/ray_offset.h"
 #include "material/bsdf.h"
 #include "util/r2.h"
@@ -56,6 +59,23 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
     double share = t->sample_share;
     t->gather = (zone_gather_slot){0};
     t->sample_share = 0.0;
+    /* The hits this sample's gather of the level before found, or room to
+     * keep this one's for the level after. */
+    hit *kept = NULL;
+    int reuse = 0;
+    zone_gather_memo *memo = t->memo;
+    if (memo && slot.sample < ZONE_MEMO_SAMPLES &&
+        ((size_t)slot.sample + 1) * (size_t)k_max <= ZONE_MEMO_HITS) {
+        if (memo->pixel != slot.pixel) {
+            memo->pixel = slot.pixel;
+            memset(memo->have, 0, sizeof memo->have);
+        }
+        kept = memo->hits + (size_t)slot.sample * k_max;
+        vec3f was = memo->origin[slot.sample];
+        reuse = memo->have[slot.sample] && was.x == o.x && was.y == o.y && was.z == o.z;
+        memo->have[slot.sample] = 1;
+        memo->origin[slot.sample] = o;
+    }
     vec3 sum = v3(0, 0, 0);
     for (int k = 0; k < k_max; k++) {
         double u, v;
@@ -66,8 +86,16 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
          * no light from there. */
         if (f3_dot(d, nf) <= 0.0f)
             continue;
-        sum = v3_add(sum, zone_radiance(t, o, f3_normalize(d), level, level,
-                                        ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0));
+        d = f3_normalize(d);
+        if (kept) {
+            if (!reuse) {
+                kept[k] = accel_intersect(&t->r->rs, o, d);
+                t->rays++;
+            }
+            t->first_hit = &kept[k];
+        }
+        sum = v3_add(sum, zone_radiance(t, o, d, level, level, ZR_NO_GLINT | ZR_NO_CAUSTIC,
+                                        NULL, 0));
     }
     t->light_split = save;
     t->gather = slot;

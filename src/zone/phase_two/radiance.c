@@ -44,11 +44,18 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
      * the lobe's light samples (rough.c). */
     float mis = t->mis_pdf;
     t->mis_pdf = 0.0f;
+    const hit *given = t->first_hit;
+    t->first_hit = NULL;
     if (hi < 0 || lo > hi)
         return v3(0, 0, 0);
     const rscene *rs = &t->r->rs;
-    hit h = accel_intersect(rs, o, d);
-    t->rays++;
+    hit h;
+    if (given) {
+        h = *given;
+    } else {
+        h = accel_intersect(rs, o, d);
+        t->rays++;
+    }
     if (h.part < 0)
         return lo <= 0 ? background(rs, d, mis) : v3(0, 0, 0);
     rs_part tmp;

@@ -93,6 +93,11 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
         zone_trace t = {.f = c->f, .r = c->r};
+        /* The gathers' hits, kept from a pixel's one level to the next:
+         * the same rays (gather.c). */
+        t.memo = malloc(sizeof *t.memo);
+        if (t.memo)
+            t.memo->pixel = UINT32_MAX;
         p2_row row;
         memset(&row, 0, sizeof row);
         int *list = NULL, cap = 0;
@@ -120,6 +125,7 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
             progress_add(&prog, 1.0);
         }
         free(list);
+        free(t.memo);
         p2_row_free(&row);
         rays += t.rays;
     }
