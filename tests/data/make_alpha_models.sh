@@ -10,7 +10,7 @@ here="$(cd "$(dirname "$0")" && pwd)"
 make="python3 $here/../../tools/make_pbr_gltf.py"
 out="$here/alpha"
 mkdir -p "$out"
-rm -f "$out"/*
+rm -f "$out"/*.gltf "$out"/*.bin "$out"/*.png
 plain="--metal 0 --rough 1 --no-normal --no-mr"
 # A white diffuse square whose 8 stripes along u are alternately covered
 # (alpha 255) and holes (alpha 0): alphaMode MASK, the default cutoff.
