@@ -13,8 +13,7 @@
 /* What reaches o from the point at distance dist along unit d, as a
  * colour factor: accel_occluded's rule (the same background rule), with
  * panes and partial coverage on the way multiplying instead of blocking.
- * Scenes without either
- * pay one accel_occluded call and get 0 or 1. */
+ * Scenes without either pay one accel_occluded call and get 0 or 1. */
 vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
                           int target_is_background);
 
