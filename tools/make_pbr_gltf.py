@@ -5,6 +5,8 @@ Python (json, struct, zlib): a test model for model files' materials.
     python3 tools/make_pbr_gltf.py OUT.gltf [--rough R] [--metal M] [--tilt DEG] [--scale S]
                                    [--size N] [--tangents] [--base-size N] [--color R G B]
                                    [--no-normal] [--no-mr] [--metal-right M]
+                                   [--alpha-mode MODE] [--alpha A] [--alpha-cutoff C]
+                                   [--stripes]
 
 The model is one square of side 2 in the plane y = 0, centred on the origin, its front face (and
 normal) up, +x along the texture's u and -z along its v (so the image's left half is x < 0 and
@@ -28,6 +30,13 @@ whose size differs from the maps'.  With --tangents the vertices carry TANGENT (
 without, the reader makes its own.  --no-normal leaves the normal texture out, --no-mr the
 metallic-roughness one (the factors then give metallic --metal and roughness --rough).
 
+--alpha-mode writes the material's alphaMode (OPAQUE, MASK or BLEND), --alpha the base colour
+factor's alpha (default 1), --alpha-cutoff its alphaCutoff as given (even outside [0, 1], or nan,
+which json writes as the non-standard NaN: for tests of bad input).  --stripes writes a white
+base-colour texture of N x N texels ("_base.png", RGBA) whose alpha alternates along u, column by
+column: 255 in the even columns (the first at x = -1), 0 in the odd ones, so that the square's
+N stripes of width 2/N alternate between covered and not.
+
 Texel codes are exact: a test computes what it expects from the same rounding.
 """
 import json
@@ -39,14 +48,17 @@ import zlib
 
 
 def png(path, width, height, rows):
-    """An 8-bit RGB PNG without colour-space chunks (glTF's maps are linear)."""
+    """An 8-bit RGB (or RGBA, for texels of four values) PNG without colour-space chunks (glTF's
+    maps are linear)."""
 
     def chunk(kind, data):
         body = kind + data
         return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xffffffff)
 
     raw = b"".join(b"\x00" + bytes(v for texel in row for v in texel) for row in rows)
-    data = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+    colour_type = 6 if len(rows[0][0]) == 4 else 2
+    data = (b"\x89PNG\r\n\x1a\n"
+            + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, colour_type, 0, 0, 0))
             + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
     with open(path, "wb") as f:
         f.write(data)
@@ -62,13 +74,15 @@ def halves(n, left, right):
 
 def main(argv):
     args = {"rough": 1.0, "metal": 1.0, "tilt": 0.0, "scale": 1.0, "size": 4, "tangents": False,
-            "base_size": 0, "color": [1.0, 1.0, 1.0], "normal": True, "mr": True}
+            "base_size": 0, "color": [1.0, 1.0, 1.0], "normal": True, "mr": True,
+            "alpha_mode": None, "alpha": 1.0, "alpha_cutoff": None, "stripes": False}
     out = None
     i = 0
     try:
         while i < len(argv):
             a = argv[i]
-            if a in ("--rough", "--metal", "--tilt", "--scale", "--metal-right"):
+            if a in ("--rough", "--metal", "--tilt", "--scale", "--metal-right", "--alpha",
+                     "--alpha-cutoff"):
                 args[a[2:].replace("-", "_")] = float(argv[i + 1])
                 i += 2
             elif a in ("--size", "--base-size"):
@@ -77,8 +91,13 @@ def main(argv):
             elif a == "--color":
                 args["color"] = [float(v) for v in argv[i + 1:i + 4]]
                 i += 4
-            elif a == "--tangents":
-                args["tangents"] = True
+            elif a == "--alpha-mode":
+                if argv[i + 1] not in ("OPAQUE", "MASK", "BLEND"):
+                    raise ValueError(argv[i + 1])
+                args["alpha_mode"] = argv[i + 1]
+                i += 2
+            elif a in ("--tangents", "--stripes"):
+                args[a[2:]] = True
                 i += 1
             elif a in ("--no-normal", "--no-mr"):
                 args[a[5:]] = False
@@ -136,7 +155,8 @@ def main(argv):
         accessors.append({"bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC4"})
         attributes["TANGENT"] = 4
     images = []
-    pbr = {"baseColorFactor": args["color"] + [1.0], "metallicFactor": 1.0, "roughnessFactor": 1.0}
+    pbr = {"baseColorFactor": args["color"] + [args["alpha"]], "metallicFactor": 1.0,
+           "roughnessFactor": 1.0}
     if args["mr"]:
         pbr["metallicRoughnessTexture"] = {"index": len(images)}
         images.append({"uri": stem + "_mr.png"})
@@ -146,7 +166,16 @@ def main(argv):
     if args["normal"]:
         material["normalTexture"] = {"index": len(images), "scale": args["scale"]}
         images.append({"uri": stem + "_n.png"})
-    if args["base_size"] > 0:
+    if args["alpha_mode"]:
+        material["alphaMode"] = args["alpha_mode"]
+    if args["alpha_cutoff"] is not None:
+        material["alphaCutoff"] = args["alpha_cutoff"]
+    if args["stripes"]:
+        png(os.path.join(folder, stem + "_base.png"), n, n,
+            [[(255, 255, 255, 0 if i % 2 else 255) for i in range(n)]] * n)
+        pbr["baseColorTexture"] = {"index": len(images)}
+        images.append({"uri": stem + "_base.png"})
+    elif args["base_size"] > 0:
         b = args["base_size"]
         png(os.path.join(folder, stem + "_base.png"), b, b, [[(255, 255, 255)] * b] * b)
         pbr["baseColorTexture"] = {"index": len(images)}

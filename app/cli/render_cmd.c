@@ -380,6 +380,13 @@ static void print_scene(const render_job *job)
     if (info.panes)
         fprintf(stderr, "note: %d materials are thin panes: light crosses them undeviated "
                 "(docs/scene-format.md, \"thin\")\n", info.panes);
+    if (info.alpha_masks || info.alpha_blends)
+        fprintf(stderr, "alpha: %d masked materials (holes below the cutoff), %d with partial "
+                "coverage (light passes by the uncovered share)\n", info.alpha_masks,
+                info.alpha_blends);
+    if (info.alpha_fallbacks)
+        fprintf(stderr, "note: %d model alpha cutoffs were not in [0, 1] and were clamped (%s)\n",
+                info.alpha_fallbacks, info.alpha_problem);
     if (info.missing_textures)
         fprintf(stderr, "note: %d model textures are missing or unreadable and were left "
                 "out (%s)\n", info.missing_textures, info.texture_problem);

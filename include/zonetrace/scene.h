@@ -70,6 +70,12 @@ typedef struct zt_scene_info {
     char unused[256]; /* what the models' materials have that is not used,
                          counted by kind ("2 emissive textures, 1 sheen
                          layers"); empty when nothing */
+    int alpha_masks;  /* materials with alphaMode MASK (holes where the
+                         coverage is below the cutoff) */
+    int alpha_blends; /* materials with partial coverage (BLEND, or a
+                         scene material's "coverage") */
+    int alpha_fallbacks; /* models' alpha cutoffs not in [0, 1], clamped */
+    char alpha_problem[160]; /* the first of them and what was taken */
     int has_sky;      /* non-zero when a sky colour is given */
     int panes;        /* materials (of things and of models' slots) whose
                          refractive lobe is a thin pane */

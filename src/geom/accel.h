@@ -4,7 +4,9 @@
  * The scene format's "background" rule is part of the query: a ray's hit is
  * its nearest foreground hit if it has any, otherwise its nearest background
  * hit.  Infinite planes are tested directly (there are few of them); the
- * other primitives go to the chosen backend.
+ * other primitives go to the chosen backend.  So are holes: a hit of
+ * coverage 0 (an alpha mask's, render/prim.h rs_coverage) is no hit, and
+ * the query goes on beyond it, whatever the backend.
  */
 #ifndef ZT_GEOM_ACCEL_H
 #define ZT_GEOM_ACCEL_H

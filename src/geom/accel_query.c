@@ -1,4 +1,5 @@
-/* The background rule and the planes, around the backends' raw queries. */
+/* The background rule, the planes and holes (coverage 0), around the
+ * backends' raw queries. */
 #include "geom/accel_internal.h"
 
 #include <float.h>
@@ -6,6 +7,9 @@
 
 #include "geom/bvh_traverse.h"
 #include "geom/ray4.h"
+#include "geom/ray_offset.h"
+#include "geom/shapes.h"
+#include "render/prim.h"
 #include "util/simd4.h"
 
 /* Planes: t = (offset - n.o) / (n.d), valid in (0, tmax) and, for culled
@@ -83,8 +87,48 @@ static inline int prims_any(const accel *a, int layer, const bvh_ray *b, float t
     return a->any(a, layer, b->o, b->d, tmax);
 }
 
+/* Holes (hits of coverage 0: rs_coverage_at) a query looks through
+ * before it takes the next hit as solid: a ray through more layers of
+ * leaves than this is lost in them anyway, and a ray cannot loop. */
+#define HOLES_MAX 64
+
+/* accel_intersect in a scene with coverage: a hit in a hole is no hit, the
+ * search going on from just beyond it in the same layer.  The same for
+ * every backend, so they agree as they do without holes. */
+static hit intersect_through_holes(const rscene *rs, vec3f o, vec3f d)
+{
+    const accel *a = rs->accel;
+    for (int layer = 0; layer < 2; layer++) {
+        vec3f from = o;
+        for (int k = 0;; k++) {
+            ray4 r = ray4_make(from, d);
+            bvh_ray b;
+            bvh_ray_init(&b, &r, from, d);
+            float t = FLT_MAX;
+            int part = -1;
+            prims_nearest(a, layer, &b, &t, &part);
+            planes_nearest(rs, layer, &r, &t, &part);
+            if (part < 0)
+                break; /* nothing in this layer beyond the holes */
+            rs_part tmp;
+            const rs_part *p = rs_prim(rs, part, &tmp);
+            const rs_object *m = &rs->objects[p->object];
+            vec3f x = shape_hit_point(p, from, d, t);
+            float dt = f3_dot(f3_sub(x, o), d);
+            if (k == HOLES_MAX || rs_coverage(rs, part, p, m, x) > 0.0f)
+                return (hit){k == 0 ? t : dt, part};
+            vec3f ng = shape_normal(p, x);
+            from = ray_offset(x, f3_dot(ng, d) > 0.0f ? ng : f3_neg(ng));
+        }
+    }
+    hit none = {FLT_MAX, -1};
+    return none;
+}
+
 hit accel_intersect(const rscene *rs, vec3f o, vec3f d)
 {
+    if (__builtin_expect(rs->alpha_count != 0, 0))
+        return intersect_through_holes(rs, o, d);
     const accel *a = rs->accel;
     ray4 r = ray4_make(o, d);
     bvh_ray b;
@@ -106,6 +150,18 @@ hit accel_intersect(const rscene *rs, vec3f o, vec3f d)
 int accel_occluded(const rscene *rs, vec3f o, vec3f d, float dist,
                    int target_is_background)
 {
+    if (__builtin_expect(rs->alpha_count != 0, 0)) {
+        /* The nearest hit that is not a hole, under the same rule: a
+         * foreground target is hidden by a foreground hit before it, a
+         * background one by any foreground hit or a background one
+         * before it. */
+        hit h = intersect_through_holes(rs, o, d);
+        if (h.part < 0)
+            return 0;
+        rs_part tmp;
+        int bg = rs_prim(rs, h.part, &tmp)->background;
+        return target_is_background ? (!bg || h.t < dist) : (!bg && h.t < dist);
+    }
     const accel *a = rs->accel;
     ray4 r = ray4_make(o, d);
     bvh_ray b;

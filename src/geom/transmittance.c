@@ -26,7 +26,7 @@ vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
         rs_part tmp;
         const rs_part *p = rs_prim(rs, h.part, &tmp);
         const rs_object *m = &rs->objects[p->object];
-        if (!m->thin || p->is_light) {
+        if (!rs_passes(m) || p->is_light) {
             /* A foreground target is hidden by a foreground hit before it;
              * a background hit means there was none.  Other cases keep
              * the full rule. */
@@ -37,7 +37,7 @@ vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
         vec3f x = shape_hit_point(p, o, d, h.t);
         vec3f ng = shape_normal(p, x);
         float c = f3_dot(ng, d);
-        tr = f3_mul(tr, bsdf_pane_transmittance(m, fabsf(c)));
+        tr = f3_mul(tr, bsdf_pass_through(m, rs_coverage(rs, h.part, p, m, x), fabsf(c)));
         if (f3_is_black(tr))
             return tr;
         o = ray_offset(x, c > 0.0f ? ng : f3_neg(ng));

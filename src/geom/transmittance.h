@@ -1,7 +1,10 @@
-/* Visibility through thin panes: the one query that lets light cross a
- * window.  A pane (a material whose refractive lobe is "thin") passes the
- * light it does not reflect undeviated, so a shadow ray that meets one goes
- * on, carrying the pane's transmittance; anything else blocks it. */
+/* Visibility through thin panes and partial coverage: the one query that
+ * lets light cross a window or a see-through texture.  A pane (a material
+ * whose refractive lobe is "thin") passes the light it does not reflect
+ * undeviated, a surface of coverage c < 1 (alpha) the share 1 - c, so a
+ * shadow ray that meets one goes on, carrying that transmittance
+ * (bsdf_pass_through); anything else blocks it.  Holes (coverage 0) are
+ * not hits at all (accel.h). */
 #ifndef ZT_GEOM_TRANSMITTANCE_H
 #define ZT_GEOM_TRANSMITTANCE_H
 
@@ -9,8 +12,8 @@
 
 /* What reaches o from the point at distance dist along unit d, as a
  * colour factor: accel_occluded's rule (the same background rule), with
- * panes on the way multiplying instead of blocking.  Scenes without panes
- * pay one accel_occluded call and get 0 or 1. */
+ * panes and partial coverage on the way multiplying instead of blocking.
+ * Scenes without either pay one accel_occluded call and get 0 or 1. */
 vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
                           int target_is_background);
 

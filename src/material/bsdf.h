@@ -81,6 +81,17 @@ static inline vec3f bsdf_pane_transmittance(const rs_object *m, float cos_i)
                                  (1.0f - bsdf_pane_reflectance(cos_i, m->ior)));
 }
 
+/* What crosses a hit of coverage c on m undeviated at cosine cos_i, by
+ * colour: the uncovered share 1 - c, and of the covered share what a pane
+ * passes (nothing unless m is one).  For objects that rs_passes. */
+static inline vec3f bsdf_pass_through(const rs_object *m, float c, float cos_i)
+{
+    vec3f t = f3_splat(1.0f - c);
+    if (m->thin)
+        t = f3_add(t, f3_scale(bsdf_pane_transmittance(m, cos_i), c));
+    return t;
+}
+
 /* Whether lobe k of m is a GGX lobe. */
 static inline int bsdf_lobe_rough(const rs_object *m, int k)
 {

@@ -104,6 +104,30 @@ vec3f texture_lookup_linear(const mesh_texture *t, float u, float v)
     return lookup(t, u, v, 1);
 }
 
+float texture_lookup_alpha(const mesh_texture *t, float u, float v)
+{
+    /* The same filter as lookup(), on the fourth byte. */
+    if (!isfinite(u) || !isfinite(v))
+        return t->rgba[3] * (1.0f / 255.0f);
+    double x = (double)u * t->width - 0.5, y = (1.0 - (double)v) * t->height - 0.5;
+    if (t->wrap) {
+        x = fmod(x, (double)t->width);
+        y = fmod(y, (double)t->height);
+    } else {
+        x = x < -1.0 ? -1.0 : (x > t->width ? t->width : x);
+        y = y < -1.0 ? -1.0 : (y > t->height ? t->height : y);
+    }
+    double fx = floor(x), fy = floor(y);
+    float ax = (float)(x - fx), ay = (float)(y - fy);
+    int i0 = wrap_index((int)fx, t->width, t->wrap), i1 = wrap_index((int)fx + 1, t->width, t->wrap);
+    int j0 = wrap_index((int)fy, t->height, t->wrap), j1 = wrap_index((int)fy + 1, t->height, t->wrap);
+    const unsigned char *r0 = t->rgba + 4 * (size_t)j0 * (size_t)t->width;
+    const unsigned char *r1 = t->rgba + 4 * (size_t)j1 * (size_t)t->width;
+    float top = r0[4 * i0 + 3] * (1.0f - ax) + r0[4 * i1 + 3] * ax;
+    float bot = r1[4 * i0 + 3] * (1.0f - ax) + r1[4 * i1 + 3] * ax;
+    return (top * (1.0f - ay) + bot * ay) * (1.0f / 255.0f);
+}
+
 vec3f texture_triangle_mean(const mesh_texture *t, const float *uv0, const float *uv1,
                             const float *uv2, int n)
 {

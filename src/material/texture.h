@@ -21,6 +21,10 @@ vec3f texture_lookup(const mesh_texture *t, float u, float v);
  * texels' codes c read as c / 255, without the sRGB curve. */
 vec3f texture_lookup_linear(const mesh_texture *t, float u, float v);
 
+/* The texture's alpha (coverage, linear: c / 255) at (u, v), filtered
+ * as texture_lookup filters colours. */
+float texture_lookup_alpha(const mesh_texture *t, float u, float v);
+
 /* The mean linear colour of the texture over the triangle of texture
  * coordinates uv0, uv1, uv2 (2 floats each), estimated on a fixed lattice
  * of n (n + 1) / 2 points (n >= 1); for a per-triangle albedo. */

@@ -131,21 +131,33 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
          * start stay), chosen with its probability so the weight is the
          * tint.  Otherwise the vertex is the rest of the material, its
          * weights renormalised, the pane's lobe reflecting only. */
+        /* A surface of coverage cov < 1 (alpha) passes the uncovered share
+         * the same way, untinted: passing has probability 1 - cov plus
+         * cov times the pane's, and the covered share that does not pass
+         * is the material as it is (the pane's lobe reflecting only). */
         float pane_keep = 1.0f, pane_r = 0.0f;
-        if (__builtin_expect(m->thin, 0)) {
+        if (__builtin_expect(rs_passes(m), 0)) {
             vec3f ng = shape_normal(p, x);
             float c = f3_dot(ng, d);
-            pane_r = bsdf_pane_reflectance(fabsf(c), m->ior);
-            float p_pass = m->weight[LOBE_REFRACTIVE] * (1.0f - pane_r);
+            float cov = rs_coverage(rs, h.part, p, m, x), p_pane = 0.0f;
+            if (m->thin) {
+                pane_r = bsdf_pane_reflectance(fabsf(c), m->ior);
+                p_pane = m->weight[LOBE_REFRACTIVE] * (1.0f - pane_r);
+            }
+            float p_pass = cov < 1.0f ? (1.0f - cov) + cov * p_pane : p_pane;
             if (sampler_next(&rng) < p_pass) {
-                beta = f3_mul(beta, m->tint);
+                vec3f w = m->tint;
+                if (cov < 1.0f)
+                    w = f3_scale(f3_add(f3_splat(1.0f - cov), f3_scale(m->tint, cov * p_pane)),
+                                 1.0f / p_pass);
+                beta = f3_mul(beta, w);
                 if (f3_is_black(beta) || ++panes > PANES_MAX)
                     break;
                 o = ray_offset(x, c > 0.0f ? ng : f3_neg(ng));
                 seg_t += h.t;
                 continue;
             }
-            pane_keep = 1.0f - p_pass;
+            pane_keep = 1.0f - p_pane;
         }
         if (k >= pp->max_level)
             break;

@@ -75,6 +75,52 @@ void rs_mesh_part(const rscene *rs, const rs_mesh *mm, int prim, rs_part *out)
     }
 }
 
+/* m's coverage for a base-texture alpha of a (1 without a texture). */
+static float coverage_of(const rs_object *m, float a)
+{
+    float c = m->coverage * a;
+    if (m->alpha_mode == ALPHA_MASK)
+        return c >= m->alpha_cutoff ? 1.0f : 0.0f;
+    return c > 0.0f ? (c < 1.0f ? c : 1.0f) : 0.0f;
+}
+
+float rs_coverage_mean(const rs_object *m, const float *uv0, const float *uv1, const float *uv2,
+                       int n)
+{
+    if (!m->alpha_mode)
+        return 1.0f;
+    if (!m->texture || !uv0)
+        return coverage_of(m, 1.0f);
+    float sum = 0.0f;
+    int count = 0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; i + j < n; j++) {
+            float b1 = (i + 1.0f / 3.0f) / n, b2 = (j + 1.0f / 3.0f) / n, b0 = 1.0f - b1 - b2;
+            sum += coverage_of(m, texture_lookup_alpha(m->texture,
+                                                       b0 * uv0[0] + b1 * uv1[0] + b2 * uv2[0],
+                                                       b0 * uv0[1] + b1 * uv1[1] + b2 * uv2[1]));
+            count++;
+        }
+    return count ? sum / (float)count : 1.0f;
+}
+
+float rs_coverage_at(const rscene *rs, int prim, const rs_part *p, const rs_object *m, vec3f x)
+{
+    float a = 1.0f;
+    if (m->texture && prim >= rs->part_count) {
+        const rs_mesh *mm = rs_mesh_of(rs, prim);
+        const uint32_t *v = rs_mesh_tri(mm, prim);
+        float b1, b2;
+        rs_triangle_barycentric(p, x, &b1, &b2);
+        float b0 = 1.0f - b1 - b2;
+        const float *t0 = mm->m->uv + 2 * (size_t)v[0], *t1 = mm->m->uv + 2 * (size_t)v[1];
+        const float *t2 = mm->m->uv + 2 * (size_t)v[2];
+        a = texture_lookup_alpha(m->texture, b0 * t0[0] + b1 * t1[0] + b2 * t2[0],
+                                 b0 * t0[1] + b1 * t1[1] + b2 * t2[1]);
+    }
+    return coverage_of(m, a);
+}
+
 float rs_maps_diffuse_mean(const rs_object *m, const float *uv0, const float *uv1,
                            const float *uv2, int n)
 {

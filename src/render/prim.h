@@ -98,6 +98,27 @@ static inline int rs_needs_shade(const rscene *rs, int prim, const rs_object *m)
            (prim >= rs->part_count && rs_mesh_of(rs, prim)->smooth);
 }
 
+/* The share of the surface present at hit x of primitive prim (view p,
+ * object m, which has an alpha_mode): its coverage factor times the base
+ * texture's alpha there; for ALPHA_MASK 1 at or above the cutoff, else 0.
+ * A hit of coverage 0 is a hole that rays go through (accel.h); between 0
+ * and 1 (BLEND) the surface is that share of its material and the rest
+ * lets light pass untouched. */
+float rs_coverage_at(const rscene *rs, int prim, const rs_part *p, const rs_object *m, vec3f x);
+
+/* m's mean coverage over the triangle of texture coordinates uv0, uv1,
+ * uv2 (NULL: none) on texture_triangle_mean's lattice of n (n + 1) / 2
+ * points; 1 without an alpha_mode. */
+float rs_coverage_mean(const rs_object *m, const float *uv0, const float *uv1, const float *uv2,
+                       int n);
+
+/* The coverage of a hit on any object: 1 unless m has an alpha_mode. */
+static inline float rs_coverage(const rscene *rs, int prim, const rs_part *p,
+                                const rs_object *m, vec3f x)
+{
+    return m->alpha_mode ? rs_coverage_at(rs, prim, p, m, x) : 1.0f;
+}
+
 /* The mean diffuse weight of m (which has a metal map) over the triangle
  * of texture coordinates uv0, uv1, uv2, on texture_triangle_mean's
  * lattice of n (n + 1) / 2 points. */

@@ -53,10 +53,36 @@ static void fill_object(rs_object *ro, const material *mat, vec3 emission, int i
     ro->rough = (uint8_t)(ro->alpha > 0.0f &&
                           (ro->weight[LOBE_METALLIC] > 0.0f || ro->weight[LOBE_REFLECTING] > 0.0f ||
                            (ro->weight[LOBE_REFRACTIVE] > 0.0f && !ro->thin)));
+    /* Lights have no coverage. */
+    ro->alpha_mode = (uint8_t)(is_light ? ALPHA_OPAQUE : mat->alpha_mode);
+    ro->alpha_cutoff = (float)mat->alpha_cutoff;
+    ro->coverage = (float)mat->coverage;
     ro->is_light = (uint8_t)is_light;
     ro->culled = (uint8_t)o->backculled;
     ro->background = (uint8_t)o->background;
     ro->emission = v3_to_f3(emission);
+}
+
+/* The smallest alpha code of a texture's texels. */
+static int texture_alpha_min(const mesh_texture *t)
+{
+    int lo = 255;
+    size_t n = (size_t)t->width * (size_t)t->height;
+    for (size_t i = 0; i < n && lo > 0; i++)
+        lo = t->rgba[4 * i + 3] < lo ? t->rgba[4 * i + 3] : lo;
+    return lo;
+}
+
+/* A coverage that is the same everywhere and whole makes the object
+ * opaque, which costs nothing: files often say BLEND of opaque materials. */
+static void simplify_alpha(rs_object *ro)
+{
+    if (ro->alpha_mode == ALPHA_OPAQUE)
+        return;
+    float tex = ro->texture ? texture_alpha_min(ro->texture) / 255.0f : 1.0f;
+    float lowest = ro->coverage * tex;
+    if (ro->alpha_mode == ALPHA_MASK ? lowest >= ro->alpha_cutoff : lowest >= 1.0f)
+        ro->alpha_mode = ALPHA_OPAQUE;
 }
 
 /* The meshes' table and their slots' objects (after the scene's own). */
@@ -216,8 +242,12 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
         fill_object(&rs->objects[i], &o->mat, on ? o->emission : v3(0, 0, 0), o->is_light, o);
     }
     rs->object_count = build_meshes(rs, scene, lights_off, lights_off_count);
-    for (int i = 0; i < rs->object_count; i++)
-        rs->pane_count += rs->objects[i].thin;
+    for (int i = 0; i < rs->object_count; i++) {
+        rs_object *ro = &rs->objects[i];
+        simplify_alpha(ro);
+        rs->pane_count += rs_passes(ro) != 0;
+        rs->alpha_count += ro->alpha_mode != ALPHA_OPAQUE;
+    }
 
     double total = 0;
     for (int i = 0; i < scene->part_count; i++) {

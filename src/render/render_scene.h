@@ -59,7 +59,12 @@ typedef struct rs_object {
     uint8_t rough;      /* a lobe is GGX (material/microfacet.h): alpha > 0
                            and a metallic, reflecting or non-pane
                            refractive weight */
+    uint8_t alpha_mode; /* ALPHA_MASK or ALPHA_BLEND: the surface covers a
+                           share of each hit (rs_coverage_at, prim.h) and
+                           light passes by the rest; ALPHA_OPAQUE: all */
     float alpha;        /* GGX alpha = roughness^2 (0: smooth lobes) */
+    float alpha_cutoff; /* MASK: coverage below it is a hole */
+    float coverage;     /* coverage factor (times the texture's alpha) */
     vec3f tint;         /* a pane's transmission colour */
     const struct mesh_texture *texture; /* base colour, times color; NULL */
     const rs_maps *maps; /* a model material's maps (NULL: none): weight,
@@ -68,6 +73,13 @@ typedef struct rs_object {
                             largest), and rs_shade_at gives the material
                             at a hit */
 } rs_object;
+
+/* Whether light may cross m's surface undeviated somewhere: a pane or a
+ * coverage below 1. */
+static inline int rs_passes(const rs_object *m)
+{
+    return m->thin | m->alpha_mode;
+}
 
 /* A mesh of the scene model as the renderers see it: its arrays are the
  * scene's (shared, not copied); its triangles are primitives
@@ -133,8 +145,11 @@ typedef struct rscene {
     int object_count;
     rs_light *lights;   /* parts sampled by next-event estimation */
     int light_count;
-    int pane_count;     /* objects with a thin refractive lobe: visibility
-                           queries then see through them (accel.h) */
+    int pane_count;     /* objects light may pass: a thin refractive lobe
+                           or a coverage below 1 (rs_passes): visibility
+                           queries then see through them (transmittance.h) */
+    int alpha_count;    /* objects with a coverage (alpha_mode): nearest-hit
+                           queries skip their holes (accel.h) */
     int *point_lights;  /* point-light parts, switched off or not */
     int point_light_count;
     /* Infinite planes of each layer ([0] foreground, [1] background), kept

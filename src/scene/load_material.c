@@ -1,6 +1,6 @@
 /* Materials: the four lobe weights, the albedo, the refractive index,
- * the roughness of the non-diffuse lobes and whether the refractive lobe is
- * a thin pane. */
+ * the roughness of the non-diffuse lobes, whether the refractive lobe is
+ * a thin pane, and the coverage. */
 #include "scene/scene_reader.h"
 
 #include <math.h>
@@ -41,7 +41,7 @@ static zt_status load_character(load_ctx *ctx, jref ref, double *weight)
 zt_status load_material(load_ctx *ctx, jref ref, material *out)
 {
     static const char *const keys[] = {
-        "character", "color", "refractiveindex", "roughness", "thin", NULL
+        "character", "color", "coverage", "refractiveindex", "roughness", "thin", NULL
     };
     material m = material_default();
     if (load_object(ctx, ref, "material") ||
@@ -73,6 +73,16 @@ zt_status load_material(load_ctx *ctx, jref ref, material *out)
         if (m.thin && m.weight[LOBE_REFRACTIVE] <= 0)
             return load_fail(ctx, thin,
                              "thin makes the refractive lobe a pane, but its weight is 0");
+    }
+    /* Coverage below 1: the surface is that share of itself, the rest
+     * lets light through untouched (as a model's alphaMode BLEND). */
+    jref cover = jref_member(ref.value, "coverage");
+    if (cover.value) {
+        if (load_number(ctx, cover, &m.coverage))
+            return ZT_ERR_PARSE;
+        if (!(m.coverage >= 0 && m.coverage <= 1))
+            return load_fail(ctx, cover, "coverage must be in [0, 1], not %g", m.coverage);
+        m.alpha_mode = m.coverage < 1 ? ALPHA_BLEND : ALPHA_OPAQUE;
     }
     /* A hand-written pane is tinted by the material's colour, as the
      * smooth refractive lobe is. */

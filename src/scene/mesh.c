@@ -232,8 +232,6 @@ const char *mesh_unused_name(int k)
     static const char *const names[MESH_UNUSED_COUNT] = {
         "emissive textures",
         "occlusion textures",
-        "alpha masks (alphaMode MASK)",
-        "alpha blends (alphaMode BLEND)",
         "specular layers or textures",
         "clearcoat layers",
         "sheen layers",

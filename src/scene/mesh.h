@@ -36,8 +36,6 @@ typedef struct mesh_map {
 enum {
     MESH_UNUSED_EMISSIVE_TEXTURE,
     MESH_UNUSED_OCCLUSION,
-    MESH_UNUSED_ALPHA_MASK,
-    MESH_UNUSED_ALPHA_BLEND,
     MESH_UNUSED_SPECULAR,
     MESH_UNUSED_CLEARCOAT,
     MESH_UNUSED_SHEEN,
@@ -98,6 +96,8 @@ typedef struct mesh {
     int map_fallbacks;      /* normal, roughness or metal maps left out
                                (missing or undecodable) */
     char map_problem[160];  /* the first such map and why */
+    int alpha_fallbacks;    /* alpha cutoffs not in [0, 1], clamped */
+    char alpha_problem[160]; /* the first such and what was taken */
     int unused[MESH_UNUSED_COUNT]; /* what the file has that is not used */
     char file[256];         /* the model file, as the scene names it */
 } mesh;

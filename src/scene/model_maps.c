@@ -88,11 +88,6 @@ static void count_unused(const struct aiMaterial *am, int gltf, mesh *m, int bum
                                         aiGetMaterialTextureCount(am, aiTextureType_EMISSION_COLOR);
     has[MESH_UNUSED_OCCLUSION] = aiGetMaterialTextureCount(am, aiTextureType_LIGHTMAP) ||
                                  aiGetMaterialTextureCount(am, aiTextureType_AMBIENT_OCCLUSION);
-    struct aiString mode;
-    if (gltf && aiGetMaterialString(am, "$mat.gltf.alphaMode", 0, 0, &mode) == aiReturn_SUCCESS) {
-        has[MESH_UNUSED_ALPHA_MASK] = strcmp(mode.data, "MASK") == 0;
-        has[MESH_UNUSED_ALPHA_BLEND] = strcmp(mode.data, "BLEND") == 0;
-    }
     double v;
     struct aiColor4D c;
     /* glTF's KHR_materials_specular, a specular texture (MTL's map_Ks,

@@ -228,6 +228,8 @@ static int material_texture(model_textures *tx, const struct aiMaterial *am, zt_
 static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_slot *s)
 {
     memset(s, 0, sizeof *s);
+    s->mat.alpha_cutoff = 0.5;
+    s->mat.coverage = 1.0;
     struct aiString name;
     if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS)
         clip_text(s->name, sizeof s->name, "%s", name.data);
@@ -292,6 +294,45 @@ static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_sl
     s->normal_scale = 1.0;
 }
 
+/* glTF's alphaMode, alphaCutoff and the base colour factor's alpha into
+ * the slot's material.  A cutoff that is not a number in [0, 1] is
+ * clamped into it (NaN: glTF's default 0.5), counted in m->alpha_fallbacks
+ * and named in m->alpha_problem. */
+static void map_alpha(const struct aiMaterial *am, mesh *m, mesh_slot *s)
+{
+    material *mat = &s->mat;
+    mat->alpha_mode = ALPHA_OPAQUE;
+    mat->alpha_cutoff = 0.5;
+    mat->coverage = 1.0;
+    struct aiString mode;
+    if (aiGetMaterialString(am, "$mat.gltf.alphaMode", 0, 0, &mode) != aiReturn_SUCCESS)
+        return;
+    if (strcmp(mode.data, "MASK") == 0)
+        mat->alpha_mode = ALPHA_MASK;
+    else if (strcmp(mode.data, "BLEND") == 0)
+        mat->alpha_mode = ALPHA_BLEND;
+    else
+        return;
+    struct aiColor4D c;
+    if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &c) == aiReturn_SUCCESS)
+        mat->coverage = clamp01(c.a);
+    ai_real v;
+    unsigned n = 1;
+    if (mat->alpha_mode != ALPHA_MASK ||
+        aiGetMaterialFloatArray(am, "$mat.gltf.alphaCutoff", 0, 0, &v, &n) != aiReturn_SUCCESS ||
+        n < 1)
+        return;
+    if (v >= 0.0f && v <= 1.0f) {
+        mat->alpha_cutoff = v;
+        return;
+    }
+    mat->alpha_cutoff = isnan(v) ? 0.5 : v < 0.0f ? 0.0 : 1.0;
+    if (m->alpha_fallbacks++ == 0)
+        snprintf(m->alpha_problem, sizeof m->alpha_problem,
+                 "material \"%s\": alphaCutoff %g is not in [0, 1], %g taken", s->name,
+                 (double)v, mat->alpha_cutoff);
+}
+
 static int has_extension(const char *path, const char *a, const char *b)
 {
     const char *dot = strrchr(path, '.');
@@ -320,6 +361,8 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
         m->slots[s].rough_map.texture = m->slots[s].metal_map.texture = -1;
         m->slots[s].normal_texture = -1;
         m->slots[s].normal_scale = 1.0;
+        m->slots[s].mat.alpha_cutoff = 0.5;
+        m->slots[s].mat.coverage = 1.0;
     }
     char folder[4096];
     folder_of(path, folder, sizeof folder);
@@ -331,6 +374,8 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
         if (s < 0 || s >= slot_count || !sc->mMaterials[i])
             continue;
         map_material(sc->mMaterials[i], gltf, obj, &m->slots[s]);
+        if (gltf)
+            map_alpha(sc->mMaterials[i], m, &m->slots[s]);
         m->slots[s].texture = material_texture(&tx, sc->mMaterials[i], &st, err);
         if (st == ZT_OK)
             st = model_maps(&tx, sc->mMaterials[i], gltf, &m->slots[s], err);

@@ -98,6 +98,8 @@ material material_default(void)
     m.weight[LOBE_DIFFUSE] = 1.0;
     m.ior = 1.0;
     m.tint = v3(1, 1, 1);
+    m.alpha_cutoff = 0.5;
+    m.coverage = 1.0;
     return m;
 }
 
@@ -163,6 +165,8 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
     for (int i = 0; i < scene->object_count; i++) {
         const object *o = &scene->objects[i];
         out->panes += o->mesh < 0 && o->mat.thin;
+        out->alpha_masks += o->mesh < 0 && !o->is_light && o->mat.alpha_mode == ALPHA_MASK;
+        out->alpha_blends += o->mesh < 0 && !o->is_light && o->mat.alpha_mode == ALPHA_BLEND;
         out->rough_lobes += o->mesh < 0 && !o->is_light && o->mat.roughness > 0 &&
                             o->mat.weight[LOBE_DIFFUSE] < 1;
         if (o->mesh < 0)
@@ -173,8 +177,14 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
         out->skipped_triangles += m->skipped_degenerate;
         out->replaced_normals += m->replaced_normals;
         out->rough_materials += m->rough_slots;
-        for (int s = 0; s < m->slot_count; s++)
+        for (int s = 0; s < m->slot_count; s++) {
             out->panes += m->slots[s].mat.thin;
+            out->alpha_masks += m->slots[s].mat.alpha_mode == ALPHA_MASK;
+            out->alpha_blends += m->slots[s].mat.alpha_mode == ALPHA_BLEND;
+        }
+        if (m->alpha_fallbacks && !out->alpha_fallbacks)
+            snprintf(out->alpha_problem, sizeof out->alpha_problem, "%s", m->alpha_problem);
+        out->alpha_fallbacks += m->alpha_fallbacks;
         if (m->missing_textures && !out->missing_textures)
             snprintf(out->texture_problem, sizeof out->texture_problem, "%s", m->texture_problem);
         out->missing_textures += m->missing_textures;

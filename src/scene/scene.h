@@ -24,7 +24,16 @@ typedef struct material {
     vec3 tint;                 /* a pane's transmission colour */
     double roughness;          /* of the metallic, reflecting and refractive
                                   lobes, in [0,1]; 0 smooth (GGX above) */
+    int alpha_mode;            /* ALPHA_OPAQUE (alpha ignored), ALPHA_MASK or
+                                  ALPHA_BLEND: glTF's alphaMode */
+    double alpha_cutoff;       /* MASK: coverage below it is a hole, in [0,1] */
+    double coverage;           /* the coverage factor (glTF's base colour
+                                  alpha), times a texture's alpha; unused
+                                  when opaque */
 } material;
+
+/* How a material's coverage (alpha) is read (docs/light-transport.md). */
+enum { ALPHA_OPAQUE = 0, ALPHA_MASK = 1, ALPHA_BLEND = 2 };
 
 typedef enum part_shape {
     SHAPE_SPHERE = 0,

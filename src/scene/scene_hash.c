@@ -27,6 +27,11 @@ uint64_t scene_hash(const zt_scene *sc)
         }
         if (o->mat.roughness > 0)
             fnv_f64(&h, o->mat.roughness);
+        if (o->mat.alpha_mode != ALPHA_OPAQUE) { /* (only then, as above) */
+            fnv_i32(&h, o->mat.alpha_mode);
+            fnv_f64(&h, o->mat.alpha_cutoff);
+            fnv_f64(&h, o->mat.coverage);
+        }
         fnv_v3(&h, o->emission);
         fnv_i32(&h, o->first_part);
         fnv_i32(&h, o->part_count);
@@ -80,6 +85,11 @@ uint64_t scene_hash(const zt_scene *sc)
                 fnv_f64(&h, sl->mat.roughness);
             fnv_v3(&h, sl->emission);
             fnv_i32(&h, sl->texture);
+            if (sl->mat.alpha_mode != ALPHA_OPAQUE) {
+                fnv_i32(&h, sl->mat.alpha_mode);
+                fnv_f64(&h, sl->mat.alpha_cutoff);
+                fnv_f64(&h, sl->mat.coverage);
+            }
             /* Maps: hashed only when present (earlier forests stay valid). */
             if (sl->rough_map.texture >= 0 || sl->metal_map.texture >= 0 ||
                 sl->normal_texture >= 0) {

@@ -282,8 +282,11 @@ enum {
                             caustic target (caustic.h), counts nothing if it
                             sends photons (a triangle or sphere): they carry
                             it */
-    ZR_CAUSTIC_LIGHT = 32 /* set by zone_radiance under ZR_NO_CAUSTIC: this
+    ZR_CAUSTIC_LIGHT = 32, /* set by zone_radiance under ZR_NO_CAUSTIC: this
                             very ray left a caustic target */
+    ZR_WHOLE_HIT = 64    /* the surface hit by this very ray counts whole,
+                            its coverage (alpha) being the caller's: Phase
+                            Two's samples are split at it (samples.c) */
 };
 vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count);

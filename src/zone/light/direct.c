@@ -401,7 +401,7 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
     /* Infinite planes are few and in no index. */
     for (int i = 0; i < sc->part_count; i++)
         if (i != receiver && i != light && sc->parts[i].shape == SHAPE_PLANE) {
-            if (c->rs->objects[c->rs->parts[i].object].thin)
+            if (rs_passes(&c->rs->objects[c->rs->parts[i].object]))
                 return -1;
             if (occlude_by(c, i, &lpp, f, x, n, &fr, set, scratch))
                 return 0;
@@ -413,11 +413,11 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
     for (int k = 0; k < found; k++) {
         if (cand[k] == receiver || cand[k] == light)
             continue;
-        /* A pane lets part of the light through: not a shadow that
-         * clipping can draw, so its points take rays (which see through
-         * it). */
+        /* A pane, or a surface with holes or partial coverage (alpha),
+         * lets part of the light through: not a shadow that clipping can
+         * draw, so its points take rays (which see through it). */
         rs_part tmp;
-        if (c->rs->pane_count && c->rs->objects[rs_prim(c->rs, cand[k], &tmp)->object].thin)
+        if (c->rs->pane_count && rs_passes(&c->rs->objects[rs_prim(c->rs, cand[k], &tmp)->object]))
             return -1;
         if (occlude_by(c, cand[k], &lpp, f, x, n, &fr, set, scratch))
             return 0;

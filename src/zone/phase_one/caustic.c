@@ -183,6 +183,20 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     vec3f ngf = shape_normal(p, xf);
     int back = f3_dot(ngf, d) > 0.0f;
     vec3f nf = back ? f3_neg(ngf) : ngf;
+    /* Coverage c < 1 (alpha): 1 - c of the flux goes on undeviated at the
+     * same count of events (as through a pane, direct light after none),
+     * the rest meets the surface. */
+    if (__builtin_expect(m->alpha_mode != 0, 0)) {
+        float c = rs_coverage_at(rs, h.part, p, m, xf);
+        if (c < 1.0f) {
+            double sp = share * (1.0 - c);
+            if (k >= 1 && sp >= BRANCH_MIN)
+                follow(t, ray_offset(xf, f3_neg(nf)), d, v3_scale(flux, 1.0 - c), sp, k, 0, NULL,
+                       media, media_count);
+            flux = v3_scale(flux, c);
+            share *= c;
+        }
+    }
     /* A material with maps: its weights and roughness here (the smooth
      * lobes below keep the geometric normal). */
     rs_shade sh; /* its mat is filled only when the maps give it */

@@ -8,7 +8,9 @@
  *   along the reflected and refracted rays, deterministically: the glass
  *   lobe follows both the reflected and the transmitted ray;
  *   a thin pane passes the light behind it at the same levels (crossing
- *   it is no scattering), tinted and less what it reflects. */
+ *   it is no scattering), tinted and less what it reflects;
+ *   a surface of coverage c < 1 (alpha) is c times all of the above, plus
+ *   1 - c times the light behind it at the same levels. */
 #include "zone/zone.h"
 
 #include "geom/accel.h"
@@ -40,6 +42,8 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count)
 {
     int exact_direct = flags & ZR_EXACT_DIRECT;
+    int whole = flags & ZR_WHOLE_HIT;
+    flags &= ~ZR_WHOLE_HIT;
     /* A rough lobe's direction: its light of level 0 is weighed against
      * the lobe's light samples (rough.c). */
     float mis = t->mis_pdf;
@@ -78,8 +82,23 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         return f3_to_v3(le);
     }
     const rs_object *m = &rs->objects[p->object];
+    /* Coverage cov < 1 (alpha): the surface is cov of what follows, and
+     * the light behind it arrives at the same levels by the rest,
+     * untouched (weighed deterministically, not chosen). */
+    float cov = 1.0f;
+    vec3 behind = v3(0, 0, 0);
+    if (__builtin_expect(m->alpha_mode != 0, 0) && !whole) {
+        cov = rs_coverage_at(rs, h.part, p, m, xf);
+        if (cov < 1.0f) {
+            vec3f ng = shape_normal(p, xf);
+            t->mis_pdf = mis;
+            behind = v3_scale(zone_radiance(t, ray_offset(xf, f3_dot(ng, d) > 0.0f ? ng : f3_neg(ng)),
+                                            d, lo, hi, flags, media, media_count),
+                              1.0 - cov);
+        }
+    }
     if (hi < 1 && !m->thin) /* a pane passes level 0 on */
-        return v3(0, 0, 0);
+        return behind;
 
     vec3f ngf = shape_normal(p, xf);
     int back = f3_dot(ngf, d) > 0.0f;
@@ -179,5 +198,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         at.entering = media_indices(rs, media, media_count, p->object, m, &at.eta_i, &at.eta_t);
         out = v3_add(out, zone_rough_radiance(t, &at, ~0u, lo - 1, hi - 1, flags));
     }
+    if (cov < 1.0f)
+        out = v3_add(v3_scale(out, cov), behind);
     return out;
 }

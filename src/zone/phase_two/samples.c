@@ -121,6 +121,12 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
         vec3f n = f3_dot(ng, d) < 0.0f ? ng : f3_neg(ng);
         if (m->weight[LOBE_DIFFUSE] > 0.0f && rs->point_light_count)
             sig = (sig ^ point_light_bits(rs, x, n, rays)) * 16777619u;
+        /* Partial coverage (alpha): what lies behind is seen too, and its
+         * edges are the pixel's. */
+        if (__builtin_expect(m->alpha_mode != 0, 0) && rs_coverage_at(rs, h.part, p, m, x) < 1.0f) {
+            o = ray_offset(x, f3_neg(n));
+            continue;
+        }
         if (m->weight[LOBE_DIFFUSE] >= 1.0f)
             break;
         float cos_o = -f3_dot(d, n);
@@ -190,8 +196,8 @@ static zone_gather_slot gather_slot(const p2_ctx *c, int px, int py, int index, 
     return g;
 }
 
-static int push_sample(const rscene *rs_of_row, p2_row *row, vec3f o, vec3f d, hit h, double w,
-                       int light_split, zone_gather_slot gather)
+static int push_one_sample(const rscene *rs_of_row, p2_row *row, vec3f o, vec3f d, hit h,
+                           double w, int light_split, zone_gather_slot gather)
 {
     if (row->sample_count == row->sample_capacity) {
         size_t cap = row->sample_capacity ? 2 * row->sample_capacity : 1024;
@@ -205,6 +211,35 @@ static int push_sample(const rscene *rs_of_row, p2_row *row, vec3f o, vec3f d, h
                    light_split, w, gather};
     row->samples[row->sample_count++] = s;
     return 1;
+}
+
+/* Surfaces of partial coverage a camera sample is split at, at most. */
+#define COVER_LAYERS 8
+
+/* Pushes the sample of weight w whose ray (o, d) first hits h.  A hit of
+ * coverage c < 1 (alpha) makes two: the hit with weight c w, and what the
+ * ray meets beyond it with the rest (the same again there). */
+static int push_sample(const rscene *rs, p2_row *row, vec3f o, vec3f d, hit h, double w,
+                       int light_split, zone_gather_slot gather)
+{
+    for (int k = 0; rs->alpha_count && h.part >= 0 && k < COVER_LAYERS; k++) {
+        rs_part tmp;
+        const rs_part *p = rs_prim(rs, h.part, &tmp);
+        const rs_object *m = &rs->objects[p->object];
+        if (!m->alpha_mode)
+            break;
+        vec3f x = shape_hit_point(p, o, d, h.t);
+        float c = rs_coverage_at(rs, h.part, p, m, x);
+        if (c >= 1.0f)
+            break;
+        if (!push_one_sample(rs, row, o, d, h, w * c, light_split, gather))
+            return 0;
+        w *= 1.0 - c;
+        vec3f ng = shape_normal(p, x);
+        o = ray_offset(x, f3_dot(ng, d) > 0.0f ? ng : f3_neg(ng));
+        h = accel_intersect(rs, o, d);
+    }
+    return push_one_sample(rs, row, o, d, h, w, light_split, gather);
 }
 
 static int push_lights(p2_row *row, const seen_lights *s)

@@ -355,7 +355,8 @@ void p2_reference(const p2_ctx *c, zone_trace *t, const p2_pixel *px, double acc
         t->gather = px->s[i].gather;
         t->sample_share = px->s[i].w;
         add(acc, px->s[i].w,
-            zone_radiance(t, px->s[i].o, px->s[i].d, c->lo, c->hi, SHADE_FLAGS, NULL, 0));
+            zone_radiance(t, px->s[i].o, px->s[i].d, c->lo, c->hi, SHADE_FLAGS | ZR_WHOLE_HIT,
+                          NULL, 0));
     }
     t->light_split = 0;
     t->gather = (zone_gather_slot){0};

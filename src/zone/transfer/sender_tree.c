@@ -24,6 +24,9 @@ static void element_albedo(const rscene *rs, int prim, const vec3 q[4], int corn
     const rs_object *o = &rs->objects[p->object];
     vec3f col = o->color;
     float k = o->weight[LOBE_DIFFUSE] / (float)PI;
+    /* Coverage (alpha): the element sends its mean covered share. */
+    if (o->alpha_mode && !(o->texture && prim >= rs->part_count))
+        k *= rs_coverage_mean(o, NULL, NULL, NULL, 1);
     if ((o->texture || (o->maps && o->maps->metal)) && prim >= rs->part_count) {
         const rs_mesh *mm = rs_mesh_of(rs, prim);
         if (mm->m->uv) {
@@ -43,6 +46,8 @@ static void element_albedo(const rscene *rs, int prim, const vec3 q[4], int corn
              * object's mean. */
             if (o->maps && o->maps->metal)
                 k = rs_maps_diffuse_mean(o, uv[0], uv[1], uv[2], 4) / (float)PI;
+            if (o->alpha_mode)
+                k *= rs_coverage_mean(o, uv[0], uv[1], uv[2], 4);
         }
     }
     out[0] = col.x * k;
