@@ -204,6 +204,8 @@ static void test_unused_and_left_out(void **state)
     zt_scene_get_info(sc, &info);
     assert_string_equal(info.unused, "");
     assert_int_equal(info.map_fallbacks, 0);
+    /* Its two triangles, 8 texels along their legs, cut 8 ways each. */
+    assert_int_equal(info.emissive_pieces, 2 * 8 * 8 - 2);
     zt_scene_release(sc);
 
     /* No emissiveFactor: glTF's default, black, so no light; the texture
