@@ -202,5 +202,107 @@ def main(argv):
     return 0
 
 
+EMISSIVE_USAGE = """Writes a square lamp: make_pbr_gltf.py's square (side 2 in y = 0, front face up, +x along u,
+-z along v) whose material emits through an emissive texture of N x N texels (--size, default 8),
+sRGB, in halves along u: the left half (x < 0) LEFT (--left R G B, codes 0-255, default 255 255
+255), the right half black.
+
+    python3 tools/make_pbr_gltf.py emissive OUT.gltf [--size N] [--left R G B] [--factor R G B]
+                                   [--strength S] [--no-factor]
+
+The material: baseColorFactor white, metallic 0, emissiveFactor --factor (default 1 1 1; with
+--no-factor none, which glTF reads as black), KHR_materials_emissive_strength --strength (left out
+when 1).  Next to OUT go OUT's stem + ".bin" and "_e.png".
+"""
+
+
+def emissive_main(argv):
+    """A square lamp with an emissive texture (EMISSIVE_USAGE)."""
+    opt = {"size": 8, "left": [255, 255, 255], "factor": [1.0, 1.0, 1.0], "strength": 1.0}
+    out = None
+    i = 0
+    try:
+        while i < len(argv):
+            a = argv[i]
+            if a == "--size":
+                opt["size"] = int(argv[i + 1])
+                i += 2
+            elif a == "--strength":
+                opt["strength"] = float(argv[i + 1])
+                i += 2
+            elif a in ("--left", "--factor"):
+                opt[a[2:]] = [(int if a == "--left" else float)(v) for v in argv[i + 1:i + 4]]
+                if len(opt[a[2:]]) != 3:
+                    raise ValueError(a)
+                i += 4
+            elif a == "--no-factor":
+                opt["factor"] = None
+                i += 1
+            elif a.startswith("-") or out:
+                raise ValueError(a)
+            else:
+                out = a
+                i += 1
+    except (ValueError, IndexError):
+        out = None
+    if not out or not out.endswith(".gltf") or opt["size"] < 2 or opt["size"] % 2:
+        sys.stderr.write(EMISSIVE_USAGE)
+        return 1
+    folder, name = os.path.split(out)
+    stem = name[:-len(".gltf")]
+    n = opt["size"]
+    uri = stem + "_e.png"
+    png(os.path.join(folder, uri), n, n, halves(n, tuple(opt["left"]), (0, 0, 0)))
+    pos = [(-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1)]
+    uv = [(0, 1), (1, 1), (1, 0), (0, 0)]
+    nrm = [(0, 1, 0)] * 4
+    idx = [0, 1, 2, 0, 2, 3]
+    blobs = [b"".join(struct.pack("<3f", *p) for p in pos), b"".join(struct.pack("<3f", *p) for p in nrm),
+             b"".join(struct.pack("<2f", *p) for p in uv), struct.pack("<6H", *idx) + b"\x00\x00"]
+    views, offset = [], 0
+    for b in blobs:
+        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(b)})
+        offset += len(b)
+    views[3]["byteLength"] = 12
+    buffer = b"".join(blobs)
+    with open(os.path.join(folder, stem + ".bin"), "wb") as f:
+        f.write(buffer)
+    material = {"name": "lamp",
+                "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0.0},
+                "emissiveTexture": {"index": 0}}
+    if opt["factor"] is not None:
+        material["emissiveFactor"] = opt["factor"]
+    doc = {
+        "asset": {"version": "2.0", "generator": "zonetrace tools/make_pbr_gltf.py emissive"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2},
+                                    "indices": 3, "material": 0}]}],
+        "materials": [material],
+        "samplers": [{"wrapS": 33071, "wrapT": 33071}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "images": [{"uri": uri}],
+        "buffers": [{"uri": stem + ".bin", "byteLength": len(buffer)}],
+        "bufferViews": views,
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, 0, -1],
+             "max": [1, 0, 1]},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+    }
+    if opt["strength"] != 1.0:
+        material["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": opt["strength"]}}
+        doc["extensionsUsed"] = ["KHR_materials_emissive_strength"]
+    with open(out, "w") as f:
+        json.dump(doc, f, indent=1)
+        f.write("\n")
+    return 0
+
+
 if __name__ == "__main__":
+    if sys.argv[1:2] == ["emissive"]:
+        sys.exit(emissive_main(sys.argv[2:]))
     sys.exit(main(sys.argv[1:]))

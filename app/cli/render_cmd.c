@@ -391,9 +391,12 @@ static void print_scene(const render_job *job)
         fprintf(stderr, "note: %d model textures are missing or unreadable and were left "
                 "out (%s)\n", info.missing_textures, info.texture_problem);
     if (info.map_fallbacks)
-        fprintf(stderr, "note: %d model normal, roughness or metal maps were left out, the "
-                "materials' factors and the interpolated normals taking their place (%s)\n",
+        fprintf(stderr, "note: %d model normal, roughness, metal or emissive maps were left out, "
+                "the materials' factors and the interpolated normals taking their place (%s)\n",
                 info.map_fallbacks, info.map_problem);
+    if (info.emissive_pieces)
+        fprintf(stderr, "emissive textures: %lld triangles added, cutting emissive triangles "
+                "where their texture varies\n", info.emissive_pieces);
     if (info.unused[0])
         fprintf(stderr, "note: model materials have what is not used yet: %s\n", info.unused);
     fprintf(stderr, "method %s, depth %d, level %s%d\n",

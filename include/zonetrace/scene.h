@@ -63,12 +63,12 @@ typedef struct zt_scene_info {
     int missing_textures; /* textures a model names but that are missing or
                              cannot be decoded (left out: base colour only) */
     char texture_problem[160]; /* the first of them and why */
-    int map_fallbacks; /* models' normal, roughness and metal maps left out
-                          (missing or cannot be decoded): the factors
-                          alone, the interpolated normal */
+    int map_fallbacks; /* models' normal, roughness, metal and emissive maps
+                          left out (missing or cannot be decoded): the
+                          factors alone, the interpolated normal */
     char map_problem[160]; /* the first of them and why */
     char unused[256]; /* what the models' materials have that is not used,
-                         counted by kind ("2 emissive textures, 1 sheen
+                         counted by kind ("2 occlusion textures, 1 sheen
                          layers"); empty when nothing */
     int alpha_masks;  /* materials with alphaMode MASK (holes where the
                          coverage is below the cutoff) */
@@ -76,6 +76,9 @@ typedef struct zt_scene_info {
                          scene material's "coverage") */
     int alpha_fallbacks; /* models' alpha cutoffs not in [0, 1], clamped */
     char alpha_problem[160]; /* the first of them and what was taken */
+    long long emissive_pieces; /* triangles the import added by cutting
+                                  emissive ones where their texture varies
+                                  (docs/scene-format.md) */
     int has_sky;      /* non-zero when a sky colour is given */
     int panes;        /* materials (of things and of models' slots) whose
                          refractive lobe is a thin pane */

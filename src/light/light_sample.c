@@ -5,12 +5,12 @@
 #include "material/bsdf.h"
 #include "util/sincos_turn.h"
 
-vec3f light_emitted(const rscene *rs, const rs_part *p, vec3f y, vec3f d)
+vec3f light_emitted(const rscene *rs, int prim, const rs_part *p, vec3f y, vec3f d)
 {
     const rs_object *o = &rs->objects[p->object];
     if (p->culled && f3_dot(shape_normal(p, y), d) >= 0.0f)
         return f3_splat(0.0f);
-    return o->emission;
+    return rs_emission_at(rs, prim, p, o, y);
 }
 
 /* Binary search with the halves chosen by conditional moves: u is
@@ -91,10 +91,12 @@ static int sample_sphere(const rs_part *p, vec3f x, const float u2[2],
 }
 
 static int sample_triangle(const rs_part *p, vec3f x, const float u2[2],
-                           light_sample *out)
+                           light_sample *out, float *b1_out, float *b2_out)
 {
     float su = sqrtf(u2[0]);
     float b1 = su * (1.0f - u2[1]), b2 = su * u2[1];
+    *b1_out = b1;
+    *b2_out = b2;
     vec3f y = f3_add(p->p0, f3_add(f3_scale(p->e1, b1), f3_scale(p->e2, b2)));
     float d2 = aim_at(x, y, out);
     if (d2 <= 0.0f)
@@ -118,6 +120,7 @@ int light_sample_point(const rscene *rs, vec3f x, float u_select,
     out->part = l->part;
     out->delta = 0;
     int ok;
+    float b1 = 0.0f, b2 = 0.0f;
     switch (p->shape) {
     case SHAPE_POINT: {
         vec3f v = f3_sub(p->p0, x);
@@ -132,12 +135,14 @@ int light_sample_point(const rscene *rs, vec3f x, float u_select,
         return 1;
     }
     case SHAPE_SPHERE: ok = sample_sphere(p, x, u2, out); break;
-    case SHAPE_TRIANGLE: ok = sample_triangle(p, x, u2, out); break;
+    case SHAPE_TRIANGLE: ok = sample_triangle(p, x, u2, out, &b1, &b2); break;
     default: ok = 0; break;
     }
     if (!ok || !(out->pdf > 0.0f) || !isfinite(out->pdf))
         return 0;
-    out->li = o->emission;
+    /* The texel at the point: the choice went by the mean, so the
+     * estimate stays unbiased and MIS's densities are unchanged. */
+    out->li = o->emissive ? rs_emission_bary(rs, l->part, o, b1, b2) : o->emission;
     out->pdf *= p->select_pdf;
     return 1;
 }

@@ -28,8 +28,9 @@ int light_sample_point(const rscene *rs, vec3f x, float u_select,
  * from x, reaching light primitive p (rs_prim) at distance t. */
 float light_pdf(const rs_part *p, vec3f x, vec3f wi, float t);
 
-/* Radiance leaving light part p at point y towards direction -d (d is the
- * ray direction arriving at y). */
-vec3f light_emitted(const rscene *rs, const rs_part *p, vec3f y, vec3f d);
+/* Radiance leaving light primitive prim (view p) at point y towards
+ * direction -d (d is the ray direction arriving at y): its emission, times
+ * its emissive texture's texel at y when it has one. */
+vec3f light_emitted(const rscene *rs, int prim, const rs_part *p, vec3f y, vec3f d);
 
 #endif

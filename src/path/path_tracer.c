@@ -117,7 +117,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         vec3f x = shape_hit_point(p, o, d, h.t);
         if (p->is_light) {
             if (counted) {
-                vec3f le = light_emitted(rs, p, x, d);
+                vec3f le = light_emitted(rs, h.part, p, x, d);
                 float w = 1.0f;
                 if (!prev_delta && p->select_pdf > 0.0f)
                     w = power_heuristic(prev_pdf, light_pdf(p, prev_x, d, seg_t + h.t));

@@ -69,8 +69,8 @@ void rs_mesh_part(const rscene *rs, const rs_mesh *mm, int prim, rs_part *out)
     if (o->is_light && rs->light_power > 0.0f) {
         /* As rscene_build weighs the lights: power = luminance x pi x area
          * x sides. */
-        float power = f3_luminance(o->emission) * out->area * 3.14159265358979f *
-                      (mm->culled ? 1.0f : 2.0f);
+        float power = f3_luminance(rs_emission_mean(rs, prim, o)) * out->area *
+                      3.14159265358979f * (mm->culled ? 1.0f : 2.0f);
         out->select_pdf = power / rs->light_power;
     }
 }
@@ -119,6 +119,52 @@ float rs_coverage_at(const rscene *rs, int prim, const rs_part *p, const rs_obje
                                  b0 * t0[1] + b1 * t1[1] + b2 * t2[1]);
     }
     return coverage_of(m, a);
+}
+
+vec3f rs_emission_bary(const rscene *rs, int prim, const rs_object *o, float b1, float b2)
+{
+    if (!o->emissive || prim < rs->part_count)
+        return o->emission;
+    const rs_mesh *mm = rs_mesh_of(rs, prim);
+    const uint32_t *v = rs_mesh_tri(mm, prim);
+    const float *uv = mm->m->uv;
+    float b0 = 1.0f - b1 - b2;
+    float u = b0 * uv[2 * v[0]] + b1 * uv[2 * v[1]] + b2 * uv[2 * v[2]];
+    float w = b0 * uv[2 * v[0] + 1] + b1 * uv[2 * v[1] + 1] + b2 * uv[2 * v[2] + 1];
+    return f3_mul(o->emission, texture_lookup(o->emissive, u, w));
+}
+
+vec3f rs_emission_triangle_mean(const rs_object *o, const mesh *m, int t)
+{
+    const uint32_t *v = m->index + 3 * (size_t)t;
+    const float *uv[3] = {m->uv + 2 * (size_t)v[0], m->uv + 2 * (size_t)v[1],
+                          m->uv + 2 * (size_t)v[2]};
+    const mesh_texture *tex = o->emissive;
+    /* The longest side in texels: a step between texels is then crossed
+     * by about 4 points, which puts the mean of a texture with sharp
+     * edges within a few parts in a thousand. */
+    double span = 0.0;
+    for (int k = 0; k < 3; k++) {
+        const float *a = uv[k], *b = uv[(k + 1) % 3];
+        double du = fabs((double)b[0] - a[0]) * tex->width;
+        double dv = fabs((double)b[1] - a[1]) * tex->height;
+        span = fmax(span, fmax(du, dv));
+    }
+    int n = isfinite(span) ? (int)fmin(64.0, ceil(4.0 * span)) : 64;
+    n = n < 2 ? 2 : n;
+    vec3f sum = f3_splat(0.0f);
+    /* The centroids of the n^2 triangles: (i + 1/3, j + 1/3) / n for the
+     * ones pointing as the whole does, (i + 2/3, j + 2/3) / n for the
+     * others. */
+    for (int i = 0; i < n; i++)
+        for (int j = 0; i + j < n; j++)
+            for (int up = 0; up < 2 && (up == 0 || i + j < n - 1); up++) {
+                float off = up ? 2.0f / 3.0f : 1.0f / 3.0f;
+                float b1 = (i + off) / n, b2 = (j + off) / n, b0 = 1.0f - b1 - b2;
+                sum = f3_add(sum, texture_lookup(tex, b0 * uv[0][0] + b1 * uv[1][0] + b2 * uv[2][0],
+                                                 b0 * uv[0][1] + b1 * uv[1][1] + b2 * uv[2][1]));
+            }
+    return f3_mul(o->emission, f3_scale(sum, 1.0f / ((float)n * (float)n)));
 }
 
 float rs_maps_diffuse_mean(const rs_object *m, const float *uv0, const float *uv1,

@@ -69,6 +69,40 @@ static inline void rs_triangle_barycentric(const rs_part *p, vec3f x, float *b1,
     *b2 = (d00 * d21 - d01 * d20) * inv;
 }
 
+/* The radiance light primitive `prim` (object o) emits at barycentric
+ * weights b1, b2 of its triangle: o's emission, times the emissive
+ * texture's texel there for a mesh triangle with one.  Sides and culling
+ * are the caller's (light_emitted). */
+vec3f rs_emission_bary(const rscene *rs, int prim, const rs_object *o, float b1, float b2);
+
+/* The same at point x of the primitive (view p). */
+static inline vec3f rs_emission_at(const rscene *rs, int prim, const rs_part *p,
+                                   const rs_object *o, vec3f x)
+{
+    if (!o->emissive)
+        return o->emission;
+    float b1, b2;
+    rs_triangle_barycentric(p, x, &b1, &b2);
+    return rs_emission_bary(rs, prim, o, b1, b2);
+}
+
+/* Its mean radiance over its surface: what its power (next-event
+ * estimation's choice) and the zone tracer's lights, polygons of one
+ * radiance, take. */
+static inline vec3f rs_emission_mean(const rscene *rs, int prim, const rs_object *o)
+{
+    if (!o->emissive || prim < rs->part_count)
+        return o->emission;
+    const rs_mesh *mm = rs_mesh_of(rs, prim);
+    return mm->emit_mean ? mm->emit_mean[prim - mm->prim_base] : o->emission;
+}
+
+/* The mean of o's emission over mesh triangle t of m (o has an emissive
+ * texture and m texture coordinates): a midpoint rule over the triangle
+ * cut into n^2 equal ones, n growing with the texels the triangle spans
+ * (about 4 points per texel along its longest side, 2 <= n <= 64). */
+vec3f rs_emission_triangle_mean(const rs_object *o, const struct mesh *m, int t);
+
 /* What shading takes from a hit besides the rs_part: the shading normal
  * (unit, on the side of the geometric normal n_facing, which faces the
  * incoming ray), the albedo (the object's colour, times its texture) and,

@@ -23,9 +23,9 @@ static int light_is_off(int index, const int *off, int n)
 
 /* Emitted power up to the radiance's colour, used to share next-event
  * samples among lights.  Planes are unbounded and not sampled (0). */
-static double part_power(const rs_part *p, const rs_object *o)
+static double part_power(const rs_part *p, vec3f emission)
 {
-    double lum = f3_luminance(o->emission);
+    double lum = f3_luminance(emission);
     switch (p->shape) {
     case SHAPE_TRIANGLE: return lum * p->area * 3.14159265358979 * (p->culled ? 1 : 2);
     case SHAPE_SPHERE: return lum * p->area * 3.14159265358979;
@@ -115,6 +115,8 @@ static int build_meshes(rscene *rs, const zt_scene *scene, const int *lights_off
             fill_object(ro, &sl->mat, sl->emission, !v3_is_black(sl->emission), o);
             if (sl->texture >= 0 && !ro->is_light && m->uv)
                 ro->texture = &m->textures[sl->texture];
+            if (sl->emissive_texture >= 0 && ro->is_light && m->uv)
+                ro->emissive = &m->textures[sl->emissive_texture];
             if (!ro->is_light && m->uv &&
                 (sl->rough_map.texture >= 0 || sl->metal_map.texture >= 0 ||
                  sl->normal_texture >= 0)) {
@@ -139,6 +141,28 @@ static int build_meshes(rscene *rs, const zt_scene *scene, const int *lights_off
     }
     rs->prim_count = prims;
     return objects;
+}
+
+/* The mean emission of each triangle of the meshes whose slots have an
+ * emissive texture (rs_mesh.emit_mean).  0 when out of memory. */
+static int emission_means(rscene *rs)
+{
+    for (int k = 0; k < rs->mesh_count; k++) {
+        rs_mesh *mm = &rs->meshes[k];
+        int any = 0;
+        for (int s = 0; s < mm->m->slot_count && !mm->is_light; s++)
+            any |= rs->objects[mm->object_base + s].emissive != NULL;
+        if (!any)
+            continue;
+        mm->emit_mean = calloc((size_t)mm->m->triangle_count, sizeof *mm->emit_mean);
+        if (!mm->emit_mean)
+            return 0;
+        for (int t = 0; t < mm->m->triangle_count; t++) {
+            const rs_object *o = &rs->objects[rs_mesh_object(mm, mm->prim_base + t)];
+            mm->emit_mean[t] = o->emissive ? rs_emission_triangle_mean(o, mm->m, t) : o->emission;
+        }
+    }
+    return 1;
 }
 
 static void fill_part(rs_part *rp, const part *p, const object *o)
@@ -242,6 +266,10 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
         fill_object(&rs->objects[i], &o->mat, on ? o->emission : v3(0, 0, 0), o->is_light, o);
     }
     rs->object_count = build_meshes(rs, scene, lights_off, lights_off_count);
+    if (!emission_means(rs)) {
+        rscene_free(rs);
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    }
     for (int i = 0; i < rs->object_count; i++) {
         rs_object *ro = &rs->objects[i];
         simplify_alpha(ro);
@@ -266,7 +294,7 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
         }
         if (rp->is_light && rp->shape == SHAPE_POINT)
             rs->point_lights[rs->point_light_count++] = i;
-        double power = rp->is_light ? part_power(rp, &rs->objects[rp->object]) : 0;
+        double power = rp->is_light ? part_power(rp, rs->objects[rp->object].emission) : 0;
         if (power > 0) {
             rp->light = rs->light_count;
             rs->lights[rs->light_count].part = i;
@@ -286,7 +314,9 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
                 continue;
             rs_part tri;
             rs_mesh_part(rs, mm, prim, &tri);
-            double power = part_power(&tri, o);
+            /* A textured light weighs by its mean; one black all over is
+             * no light to sample. */
+            double power = part_power(&tri, rs_emission_mean(rs, prim, o));
             if (power > 0) {
                 rs->lights[rs->light_count].part = prim;
                 rs->lights[rs->light_count].select_pdf = (float)power;
@@ -322,6 +352,8 @@ void rscene_free(rscene *rs)
     free(rs->maps);
     free(rs->lights);
     free(rs->point_lights);
+    for (int k = 0; k < rs->mesh_count && rs->meshes; k++)
+        free(rs->meshes[k].emit_mean);
     free(rs->meshes);
     for (int l = 0; l < 2; l++) {
         free(rs->planes[l].nx);

@@ -67,6 +67,9 @@ typedef struct rs_object {
     float coverage;     /* coverage factor (times the texture's alpha) */
     vec3f tint;         /* a pane's transmission colour */
     const struct mesh_texture *texture; /* base colour, times color; NULL */
+    const struct mesh_texture *emissive; /* a light's: emission times its
+                                            texel at the point (prim.h);
+                                            NULL */
     const rs_maps *maps; /* a model material's maps (NULL: none): weight,
                             alpha and rough are then what the maps give
                             somewhere (weights their mean, alpha the
@@ -94,6 +97,10 @@ typedef struct rs_mesh {
     uint8_t culled;
     uint8_t background;
     uint8_t smooth;     /* shading normals from the mesh's vertex normals */
+    vec3f *emit_mean;   /* per triangle, the mean emitted radiance of one
+                           whose object has an emissive texture (what its
+                           power and the zone tracer's light take); NULL
+                           when no slot has one */
 } rs_mesh;
 
 /* An emitting part that next-event estimation can sample. */

@@ -151,7 +151,7 @@ zt_status load_mesh_item(load_ctx *ctx, jref item, jref body, int line)
         /* One material for every triangle: the file's slots go. */
         m->slots[0].mat = o.mat;
         m->slots[0].emission = v3(0, 0, 0);
-        m->slots[0].texture = -1;
+        m->slots[0].texture = m->slots[0].emissive_texture = -1;
         m->slots[0].rough_map.texture = m->slots[0].metal_map.texture = -1;
         m->slots[0].normal_texture = -1;
         m->slots[0].roughness = 0;

@@ -230,7 +230,7 @@ uint64_t mesh_memory(const mesh *m)
 const char *mesh_unused_name(int k)
 {
     static const char *const names[MESH_UNUSED_COUNT] = {
-        "emissive textures",
+        "emissive textures under a black emissive factor",
         "occlusion textures",
         "specular layers or textures",
         "clearcoat layers",

@@ -34,7 +34,7 @@ typedef struct mesh_map {
 /* What a model's materials may have that the renderers do not use, counted
  * for -v (mesh_unused_name gives the words). */
 enum {
-    MESH_UNUSED_EMISSIVE_TEXTURE,
+    MESH_UNUSED_EMISSIVE_TEXTURE, /* under a black emissive factor */
     MESH_UNUSED_OCCLUSION,
     MESH_UNUSED_SPECULAR,
     MESH_UNUSED_CLEARCOAT,
@@ -51,9 +51,11 @@ const char *mesh_unused_name(int k);
 typedef struct mesh_slot {
     material mat;           /* the four-weight material; colour is the base
                                colour factor (a texture multiplies it) */
-    vec3 emission;          /* emitted radiance; not black: the slot's
-                               triangles are area lights (and black otherwise,
-                               like every light part) */
+    vec3 emission;          /* emitted radiance (the emissive factor times the
+                               strength); not black: the slot's triangles
+                               are area lights (and black otherwise, like
+                               every light part) */
+    int emissive_texture;   /* emission is times its texel (sRGB), -1: none */
     int texture;            /* base-colour texture (index into textures), -1 */
     double roughness;       /* the file's roughness factor (0 when absent),
                                also mat.roughness */
@@ -93,12 +95,14 @@ typedef struct mesh {
     int rough_slots;        /* slots with a rough (GGX) lobe */
     int missing_textures;   /* textures named but missing or undecodable */
     char texture_problem[160]; /* the first such texture and why */
-    int map_fallbacks;      /* normal, roughness or metal maps left out
-                               (missing or undecodable) */
+    int map_fallbacks;      /* normal, roughness, metal or emissive maps left
+                               out (missing or undecodable) */
     char map_problem[160];  /* the first such map and why */
     int alpha_fallbacks;    /* alpha cutoffs not in [0, 1], clamped */
     char alpha_problem[160]; /* the first such and what was taken */
     int unused[MESH_UNUSED_COUNT]; /* what the file has that is not used */
+    int emissive_pieces;    /* triangles added by cutting emissive ones
+                               (emissive_split.h) */
     char file[256];         /* the model file, as the scene names it */
 } mesh;
 

@@ -20,6 +20,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include "scene/emissive_split.h"
 #include "scene/model_materials.h"
 #include "util/error.h"
 
@@ -532,6 +533,8 @@ zt_status model_import(const char *path, const model_import_options *options, me
             m->tangent = NULL;
         }
     }
+    if (st == ZT_OK)
+        st = mesh_split_emissive(m, path, &m->emissive_pieces, err);
     if (st == ZT_OK && camera)
         read_camera(sc, path, camera);
     free(f.slot_of_material);

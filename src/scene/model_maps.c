@@ -80,12 +80,14 @@ static int bump_as_normal_map(model_textures *tx, const struct aiMaterial *am, m
 }
 
 /* Counts in m->unused what the material has that the renderers do not
- * use (bump: a height map was named and not used). */
-static void count_unused(const struct aiMaterial *am, int gltf, mesh *m, int bump)
+ * use (bump: a height map was named and not used; dark: the emission is
+ * black, so an emissive texture would multiply nothing). */
+static void count_unused(const struct aiMaterial *am, int gltf, mesh *m, int bump, int dark)
 {
     int has[MESH_UNUSED_COUNT] = {0};
-    has[MESH_UNUSED_EMISSIVE_TEXTURE] = aiGetMaterialTextureCount(am, aiTextureType_EMISSIVE) ||
-                                        aiGetMaterialTextureCount(am, aiTextureType_EMISSION_COLOR);
+    has[MESH_UNUSED_EMISSIVE_TEXTURE] =
+        dark && (aiGetMaterialTextureCount(am, aiTextureType_EMISSIVE) ||
+                 aiGetMaterialTextureCount(am, aiTextureType_EMISSION_COLOR));
     has[MESH_UNUSED_OCCLUSION] = aiGetMaterialTextureCount(am, aiTextureType_LIGHTMAP) ||
                                  aiGetMaterialTextureCount(am, aiTextureType_AMBIENT_OCCLUSION);
     double v;
@@ -184,9 +186,17 @@ zt_status model_maps(model_textures *tx, const struct aiMaterial *am, int gltf, 
     int bump_unused = 0;
     if (st == ZT_OK && !gltf && k < 0 && aiGetMaterialTextureCount(am, aiTextureType_HEIGHT))
         bump_unused = !bump_as_normal_map(tx, am, s, &st, err);
+    /* glTF's emissiveTexture, MTL's map_Ke: a colour (sRGB) times the
+     * emission.  Under a black emission (glTF's default emissiveFactor)
+     * it multiplies nothing and is not decoded.  Left out, the emission
+     * is the factor alone, as before textures were read. */
+    int dark = v3_is_black(s->emission);
+    if (st == ZT_OK && !dark)
+        s->emissive_texture =
+            find_map(tx, am, aiTextureType_EMISSIVE, "emissive texture", s, &st, err);
     if (st != ZT_OK)
         return st;
-    count_unused(am, gltf, m, bump_unused);
+    count_unused(am, gltf, m, bump_unused, dark);
     /* What the renderers take where they do not read the maps. */
     double mean, max;
     if (s->metal_map.texture >= 0) {

@@ -1,7 +1,8 @@
 /* A model material's maps besides its base colour (docs/scene-format.md,
- * "Materials from the model file"): glTF's metallic-roughness and normal
- * textures, MTL's map_Pr, map_Pm and norm; and what the file has that the
- * renderers do not use, counted for -v.  Used by model_materials.c. */
+ * "Materials from the model file"): glTF's metallic-roughness, normal and
+ * emissive textures, MTL's map_Pr, map_Pm, norm and map_Ke; and what the
+ * file has that the renderers do not use, counted for -v.  Used by
+ * model_materials.c. */
 #ifndef ZT_SCENE_MODEL_MAPS_H
 #define ZT_SCENE_MODEL_MAPS_H
 
@@ -27,8 +28,8 @@ static inline int model_material_float(const struct aiMaterial *am, const char *
 }
 
 /* The most textures one slot decodes: base colour, roughness, metal,
- * normal. */
-#define MODEL_SLOT_TEXTURES 4
+ * normal, emissive. */
+#define MODEL_SLOT_TEXTURES 5
 
 /* The refractive index given to metals: Schlick's term with index 0 is 1
  * at every angle, so the base colour is the reflectance, as glTF defines a
@@ -59,7 +60,7 @@ int model_texture_find(model_textures *tx, const struct aiMaterial *am, enum aiT
 void clip_text(char *to, size_t n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
 /* Reads slot s's maps (s already mapped from am's factors: roughness,
- * metallic, transmission) and sets its material to what the renderers
+ * metallic, transmission, emission) and sets its material to what the renderers
  * take when they are not reading the maps at a hit: the metallic weight
  * the maps' mean, the roughness their largest value (so that a slot is
  * rough when any of its texels is).  A map that cannot be decoded is left

@@ -19,6 +19,7 @@
 #include <assimp/scene.h>
 #include <assimp/texture.h>
 
+#include "scene/gltf_extensions.h"
 #include "scene/model_maps.h"
 #include "scene/texture_decode.h"
 #include "util/error.h"
@@ -224,8 +225,11 @@ static int material_texture(model_textures *tx, const struct aiMaterial *am, zt_
     return -1;
 }
 
-/* One material of the file as a slot. */
-static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_slot *s)
+/* One material of the file as a slot; strength: glTF's emissiveStrength
+ * as read from the file (gltf_extensions.h; 1 for other formats), for an
+ * Assimp that does not give it. */
+static void map_material(const struct aiMaterial *am, int gltf, int obj, double strength,
+                         mesh_slot *s)
 {
     memset(s, 0, sizeof *s);
     s->mat.alpha_cutoff = 0.5;
@@ -270,9 +274,11 @@ static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_sl
     /* One index serves both the metallic lobe's Fresnel term and glass. */
     s->mat.ior = s->mat.weight[LOBE_REFRACTIVE] > 0.0 ? ior : metallic > 0.0 ? METAL_IOR : ior;
 
+    /* glTF: emissiveFactor (Assimp gives glTF's default, black, when there
+     * is none) times KHR_materials_emissive_strength. */
     vec3 e = v3(0, 0, 0);
     if (get_color(am, AI_MATKEY_COLOR_EMISSIVE, &e)) {
-        double k = 1.0;
+        double k = strength;
         if (model_material_float(am, AI_MATKEY_EMISSIVE_INTENSITY, &v) && v >= 0.0)
             k = v;
         e = v3(fmax(e.x, 0.0) * k, fmax(e.y, 0.0) * k, fmax(e.z, 0.0) * k);
@@ -289,7 +295,7 @@ static void map_material(const struct aiMaterial *am, int gltf, int obj, mesh_sl
     else if (obj && model_material_float(am, AI_MATKEY_SHININESS, &v) && v >= 0.0)
         s->roughness = clamp01(pow(2.0 / (v + 2.0), 0.25));
     s->mat.roughness = s->roughness;
-    s->texture = -1;
+    s->texture = s->emissive_texture = -1;
     s->rough_map.texture = s->metal_map.texture = s->normal_texture = -1;
     s->normal_scale = 1.0;
 }
@@ -357,7 +363,7 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
         m->slots[s].mat.color = v3(0.8, 0.8, 0.8);
         m->slots[s].mat.ior = 1.0;
         m->slots[s].mat.tint = v3(1, 1, 1);
-        m->slots[s].texture = -1;
+        m->slots[s].texture = m->slots[s].emissive_texture = -1;
         m->slots[s].rough_map.texture = m->slots[s].metal_map.texture = -1;
         m->slots[s].normal_texture = -1;
         m->slots[s].normal_scale = 1.0;
@@ -368,12 +374,24 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
     folder_of(path, folder, sizeof folder);
     int gltf = has_extension(path, ".gltf", ".glb"), obj = has_extension(path, ".obj", NULL);
     model_textures tx = {sc, folder, path, m, names, (int)capacity};
+    /* Assimp 5.2 drops KHR_materials_emissive_strength: read from the
+     * file, by material index (Assimp keeps glTF's order; its default
+     * material comes after). */
+    double *strength = malloc(((size_t)sc->mNumMaterials + 1) * sizeof *strength);
+    if (!strength) {
+        free(names);
+        return zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", path);
+    }
+    for (unsigned i = 0; i < sc->mNumMaterials; i++)
+        strength[i] = 1.0;
+    if (gltf)
+        gltf_emissive_strengths(path, (int)sc->mNumMaterials, strength);
     zt_status st = ZT_OK;
     for (unsigned i = 0; i < sc->mNumMaterials && st == ZT_OK; i++) {
         int s = slot_of_material[i];
         if (s < 0 || s >= slot_count || !sc->mMaterials[i])
             continue;
-        map_material(sc->mMaterials[i], gltf, obj, &m->slots[s]);
+        map_material(sc->mMaterials[i], gltf, obj, strength[i], &m->slots[s]);
         if (gltf)
             map_alpha(sc->mMaterials[i], m, &m->slots[s]);
         m->slots[s].texture = material_texture(&tx, sc->mMaterials[i], &st, err);
@@ -384,6 +402,7 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
             (mat->weight[LOBE_METALLIC] > 0.0 || (mat->weight[LOBE_REFRACTIVE] > 0.0 && !mat->thin)))
             m->rough_slots++;
     }
+    free(strength);
     free(names);
     return st;
 }

@@ -191,6 +191,7 @@ void zt_scene_get_info(const zt_scene *scene, zt_scene_info *out)
         if (m->map_fallbacks && !out->map_fallbacks)
             snprintf(out->map_problem, sizeof out->map_problem, "%s", m->map_problem);
         out->map_fallbacks += m->map_fallbacks;
+        out->emissive_pieces += m->emissive_pieces;
         for (int k = 0; k < MESH_UNUSED_COUNT; k++)
             unused[k] += m->unused[k];
         for (int t = 0; t < m->triangle_count; t++) {

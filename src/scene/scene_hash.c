@@ -90,6 +90,9 @@ uint64_t scene_hash(const zt_scene *sc)
                 fnv_f64(&h, sl->mat.alpha_cutoff);
                 fnv_f64(&h, sl->mat.coverage);
             }
+            /* Hashed only when present (earlier forests stay valid). */
+            if (sl->emissive_texture >= 0)
+                fnv_i32(&h, sl->emissive_texture);
             /* Maps: hashed only when present (earlier forests stay valid). */
             if (sl->rough_map.texture >= 0 || sl->metal_map.texture >= 0 ||
                 sl->normal_texture >= 0) {

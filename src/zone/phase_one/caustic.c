@@ -356,17 +356,17 @@ static void shoot(tracer *t, const pair *pr, int i)
      * windows, and so the images of single lights, add up. */
     if (lp->culled && f3_dot(shape_normal(lp, v3_to_f3(y)), f3_neg(wf)) >= 0.0f)
         return;
-    vec3f le = light_emitted(rs, lp, v3_to_f3(y), f3_neg(wf));
+    vec3f le = light_emitted(rs, pr->light, lp, v3_to_f3(y), f3_neg(wf));
     double scale = cy * g * area / n;
     vec3 flux = v3_scale(f3_to_v3(le), scale);
     follow(t, ray_offset(v3_to_f3(y), v3_to_f3(side)), wf, flux, 1.0, 0, 0, tg, NULL, 0);
 }
 
-/* Whether light primitive lp sends photons. */
-static int sends_photons(const rscene *rs, const rs_part *lp)
+/* Whether light primitive lp (number prim) sends photons. */
+static int sends_photons(const rscene *rs, int prim, const rs_part *lp)
 {
     return lp->is_light && (lp->shape == SHAPE_TRIANGLE || lp->shape == SHAPE_SPHERE) &&
-           f3_max(rs->objects[lp->object].emission) > 0;
+           f3_max(rs_emission_mean(rs, prim, &rs->objects[lp->object])) > 0;
 }
 
 /* A target's colour and specular weight (a mesh: its brightest slot). */
@@ -399,7 +399,7 @@ static int make_pairs(const zone_forest *f, const rscene *rs, const specular_tar
     int lights = 0;
     for (int j = 0; j < rs->light_count; j++) {
         rs_part tmp;
-        lights += sends_photons(rs, rs_prim(rs, rs->lights[j].part, &tmp));
+        lights += sends_photons(rs, rs->lights[j].part, rs_prim(rs, rs->lights[j].part, &tmp));
     }
     double total_budget = (double)f->q.photons * (lights < LIGHTS_FULL ? lights : LIGHTS_FULL);
     double light_budget = lights ? total_budget / lights : 0;
@@ -416,9 +416,9 @@ static int make_pairs(const zone_forest *f, const rscene *rs, const specular_tar
         int li = rs->lights[j].part;
         rs_part tmp;
         const rs_part *lp = rs_prim(rs, li, &tmp);
-        if (!sends_photons(rs, lp))
+        if (!sends_photons(rs, li, lp))
             continue;
-        vec3 em = f3_to_v3(rs->objects[lp->object].emission);
+        vec3 em = f3_to_v3(rs_emission_mean(rs, li, &rs->objects[lp->object]));
         vec3 cl;
         double rl, total = 0;
         part_bounding_sphere(lp, &cl, &rl);

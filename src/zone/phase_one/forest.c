@@ -458,7 +458,7 @@ vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n)
         int prim = rs->lights[i].part;
         rs_part tmp;
         const rs_part *lp = rs_prim(rs, prim, &tmp);
-        vec3f em = rs->objects[lp->object].emission;
+        vec3f em = rs_emission_mean(rs, prim, &rs->objects[lp->object]);
         if (f3_is_black(em))
             continue;
         vec3 g = direct_irradiance_rgb(&t->f->direct, prim, x, n, receiver, t->light_split);
@@ -583,7 +583,8 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
         const rs_object *o = &rs->objects[lp->object];
         double area = lp->shape == SHAPE_POINT ? 4.0 : lp->area * (lp->culled ? 1.0 : 2.0);
         zone z = {rs->lights[i].part, ZONE_EMIT, 0,
-                  (float)(f3_luminance(o->emission) * 3.14159265358979 * area)};
+                  (float)(f3_luminance(rs_emission_mean(rs, rs->lights[i].part, o)) *
+                          3.14159265358979 * area)};
         if (!(z.power > 0))
             continue;
         if (z.power <= cutoff) {

@@ -130,7 +130,7 @@ static vec3 reflected(const rscene *rs, vec3 x, vec3 n, int mirror, int light, v
         k += m->weight[LOBE_REFRACTIVE] * (m->thin ? bsdf_pane_reflectance(cos_i, m->ior)
                                                    : bsdf_fresnel_dielectric(cos_i, 1.0f, m->ior));
     rs_part lt;
-    vec3f le = light_emitted(rs, rs_prim(rs, light, &lt), v3_to_f3(y),
+    vec3f le = light_emitted(rs, light, rs_prim(rs, light, &lt), v3_to_f3(y),
                              v3_to_f3(v3_normalize(v3_sub(y, s))));
     return v3_scale(v3(le.x * m->color.x, le.y * m->color.y, le.z * m->color.z), k);
 }

@@ -74,7 +74,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
     if (p->is_light) {
         if (lo > 0 || ((flags & ZR_NO_EMISSION) && h.part < rs->part_count) || photons)
             return v3(0, 0, 0);
-        vec3f le = light_emitted(rs, p, xf, d);
+        vec3f le = light_emitted(rs, h.part, p, xf, d);
         if (mis > 0.0f && p->select_pdf > 0.0f)
             le = f3_scale(le, power_heuristic(
                                   mis, light_pdf(p, t->mis_from, d,

@@ -329,7 +329,7 @@ void p2_apply(const p2_ctx *c, zone_trace *t, int k, const p2_pixel *px, double 
         case P2_EMIT: {
             rs_part tmp;
             const rs_part *p = rs_prim(&t->r->rs, s->part, &tmp);
-            v = f3_to_v3(light_emitted(&t->r->rs, p, f3_madd(s->o, s->d, s->t), s->d));
+            v = f3_to_v3(light_emitted(&t->r->rs, s->part, p, f3_madd(s->o, s->d, s->t), s->d));
             break;
         }
         case P2_DIRECT: v = direct_value(t, s); break;

@@ -424,7 +424,7 @@ int sender_tree_build_lights(sender_tree *t, const rscene *rs)
     for (int i = 0; i < k; i++) {
         rs_part tmp;
         const rs_part *p = rs_prim(rs, t->elems[i].prim, &tmp);
-        vec3f em = rs->objects[p->object].emission;
+        vec3f em = rs_emission_mean(rs, t->elems[i].prim, &rs->objects[p->object]);
         t->elem_radiance[3 * i] = em.x;
         t->elem_radiance[3 * i + 1] = em.y;
         t->elem_radiance[3 * i + 2] = em.z;
