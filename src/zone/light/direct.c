@@ -498,6 +498,15 @@ static int clips_every_point(const direct_ctx *c)
 /* Pieces whose rays' results by_rays keeps, to weigh the smaller side. */
 #define BY_RAYS_KEPT 1024
 
+static _Thread_local uint64_t rays_cast;
+
+uint64_t direct_rays_take(void)
+{
+    uint64_t n = rays_cast;
+    rays_cast = 0;
+    return n;
+}
+
 /* The centre of the sub-piece of triangle q that split point `index`
  * names at `levels` levels (direct.h): each base-4 digit, lowest first,
  * takes the quarter at corner d (d < 3) or the middle one (d = 3). */
@@ -565,6 +574,7 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
             if (lp->shape == SHAPE_SPHERE)
                 dist = sphere_entry(lp, xo, d, dist);
             s = accel_transmittance(c->rs, xo, d, dist * 0.9999f, lp->background);
+            rays_cast++;
         }
         if (keep)
             seen[at++] = s;
@@ -628,6 +638,7 @@ vec3 direct_irradiance_rgb(const direct_ctx *c, int light, vec3 x, vec3 n, int r
         float dist = f3_length(df);
         vec3f s = accel_transmittance(c->rs, ray_offset(xf, nf), f3_scale(df, 1.0f / dist),
                                       dist * 0.9999f, lp->background);
+        rays_cast++;
         return v3(s.x * cosx / d2, s.y * cosx / d2, s.z * cosx / d2);
     }
 

@@ -68,6 +68,11 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
 vec3 direct_irradiance_rgb(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
                            int split);
 
+/* The rays this thread's direct-light calls have cast since the last
+ * call (they are counted here, as the calls take no zone_trace): the
+ * callers add them to their own count. */
+uint64_t direct_rays_take(void);
+
 /* Whether direct_irradiance sees light part `light` from x by rays (too
  * many occluders to clip): where a shadow is that busy, it may change
  * within a pixel. */

@@ -194,7 +194,7 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
         e = zone_lights_at(&t, prim, x, n);
         if (f->sky)
             e = v3_add(e, zone_sky_irradiance(&t, x, n));
-        *rays += t.rays;
+        *rays += t.rays + direct_rays_take();
         return e;
     }
     /* Far out on a plane a node stands for a wide cell that matters
@@ -220,7 +220,7 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
     /* (A gather read the specular chains along its own rays.) */
     if (!*gathered && f->need_gather)
         e = v3_add(e, zone_specular_gather(&t, x, n, level));
-    *rays += t.rays;
+    *rays += t.rays + direct_rays_take();
     return e;
 }
 

@@ -42,6 +42,7 @@ zt_status p2_render_preview(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, 
                 px[1] += (float)l.y;
                 px[2] += (float)l.z;
             }
+            t.rays += direct_rays_take();
             progress_add(&prog, 1.0);
         }
         rays += t.rays;

@@ -122,6 +122,7 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
                     p2_apply(c, &t, list[k], &px, acc);
                 add_to_image(sum, x, y, acc);
             }
+            t.rays += direct_rays_take();
             progress_add(&prog, 1.0);
         }
         free(list);
@@ -163,6 +164,7 @@ zt_status p2_render_reference(const p2_ctx *c, zt_image *sum, uint64_t *rays_out
                 p2_reference(c, &t, &px, acc);
                 add_to_image(sum, x, y, acc);
             }
+            t.rays += direct_rays_take();
         }
         p2_row_free(&row);
         rays += t.rays;
@@ -312,7 +314,7 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
             }
             if (done)
                 progress_add(&prog, done);
-            rays += t.rays;
+            rays += t.rays + direct_rays_take();
         }
     }
     if (prog.cancelled) {
