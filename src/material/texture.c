@@ -69,11 +69,17 @@ static inline vec3f texel(const mesh_texture *t, int i, int j, int linear)
               texture_srgb_to_linear[p[2]]);
 }
 
-static inline vec3f lookup(const mesh_texture *t, float u, float v, int linear)
+/* The four texels around (u, v) and the bilinear weights between them
+ * (texel centres at integers; v = 1 is row 0).  Not finite: texel (0, 0). */
+typedef struct texel_quad {
+    int i0, i1, j0, j1;
+    float ax, ay;
+} texel_quad;
+
+static inline texel_quad texel_quad_at(const mesh_texture *t, float u, float v)
 {
     if (!isfinite(u) || !isfinite(v))
-        return texel(t, 0, 0, linear);
-    /* Texel coordinates with centres at integers; v = 1 is row 0. */
+        return (texel_quad){0, 0, 0, 0, 0.0f, 0.0f};
     double x = (double)u * t->width - 0.5, y = (1.0 - (double)v) * t->height - 0.5;
     /* Far coordinates are brought near first, so the ints cannot overflow. */
     if (t->wrap) {
@@ -84,14 +90,22 @@ static inline vec3f lookup(const mesh_texture *t, float u, float v, int linear)
         y = y < -1.0 ? -1.0 : (y > t->height ? t->height : y);
     }
     double fx = floor(x), fy = floor(y);
-    float ax = (float)(x - fx), ay = (float)(y - fy);
-    int i0 = wrap_index((int)fx, t->width, t->wrap), i1 = wrap_index((int)fx + 1, t->width, t->wrap);
-    int j0 = wrap_index((int)fy, t->height, t->wrap), j1 = wrap_index((int)fy + 1, t->height, t->wrap);
-    vec3f top = f3_add(f3_scale(texel(t, i0, j0, linear), 1.0f - ax),
-                       f3_scale(texel(t, i1, j0, linear), ax));
-    vec3f bot = f3_add(f3_scale(texel(t, i0, j1, linear), 1.0f - ax),
-                       f3_scale(texel(t, i1, j1, linear), ax));
-    return f3_add(f3_scale(top, 1.0f - ay), f3_scale(bot, ay));
+    texel_quad q = {wrap_index((int)fx, t->width, t->wrap),
+                    wrap_index((int)fx + 1, t->width, t->wrap),
+                    wrap_index((int)fy, t->height, t->wrap),
+                    wrap_index((int)fy + 1, t->height, t->wrap), (float)(x - fx),
+                    (float)(y - fy)};
+    return q;
+}
+
+static inline vec3f lookup(const mesh_texture *t, float u, float v, int linear)
+{
+    texel_quad q = texel_quad_at(t, u, v);
+    vec3f top = f3_add(f3_scale(texel(t, q.i0, q.j0, linear), 1.0f - q.ax),
+                       f3_scale(texel(t, q.i1, q.j0, linear), q.ax));
+    vec3f bot = f3_add(f3_scale(texel(t, q.i0, q.j1, linear), 1.0f - q.ax),
+                       f3_scale(texel(t, q.i1, q.j1, linear), q.ax));
+    return f3_add(f3_scale(top, 1.0f - q.ay), f3_scale(bot, q.ay));
 }
 
 vec3f texture_lookup(const mesh_texture *t, float u, float v)
@@ -107,25 +121,12 @@ vec3f texture_lookup_linear(const mesh_texture *t, float u, float v)
 float texture_lookup_alpha(const mesh_texture *t, float u, float v)
 {
     /* The same filter as lookup(), on the fourth byte. */
-    if (!isfinite(u) || !isfinite(v))
-        return t->rgba[3] * (1.0f / 255.0f);
-    double x = (double)u * t->width - 0.5, y = (1.0 - (double)v) * t->height - 0.5;
-    if (t->wrap) {
-        x = fmod(x, (double)t->width);
-        y = fmod(y, (double)t->height);
-    } else {
-        x = x < -1.0 ? -1.0 : (x > t->width ? t->width : x);
-        y = y < -1.0 ? -1.0 : (y > t->height ? t->height : y);
-    }
-    double fx = floor(x), fy = floor(y);
-    float ax = (float)(x - fx), ay = (float)(y - fy);
-    int i0 = wrap_index((int)fx, t->width, t->wrap), i1 = wrap_index((int)fx + 1, t->width, t->wrap);
-    int j0 = wrap_index((int)fy, t->height, t->wrap), j1 = wrap_index((int)fy + 1, t->height, t->wrap);
-    const unsigned char *r0 = t->rgba + 4 * (size_t)j0 * (size_t)t->width;
-    const unsigned char *r1 = t->rgba + 4 * (size_t)j1 * (size_t)t->width;
-    float top = r0[4 * i0 + 3] * (1.0f - ax) + r0[4 * i1 + 3] * ax;
-    float bot = r1[4 * i0 + 3] * (1.0f - ax) + r1[4 * i1 + 3] * ax;
-    return (top * (1.0f - ay) + bot * ay) * (1.0f / 255.0f);
+    texel_quad q = texel_quad_at(t, u, v);
+    const unsigned char *r0 = t->rgba + 4 * (size_t)q.j0 * (size_t)t->width;
+    const unsigned char *r1 = t->rgba + 4 * (size_t)q.j1 * (size_t)t->width;
+    float top = r0[4 * q.i0 + 3] * (1.0f - q.ax) + r0[4 * q.i1 + 3] * q.ax;
+    float bot = r1[4 * q.i0 + 3] * (1.0f - q.ax) + r1[4 * q.i1 + 3] * q.ax;
+    return (top * (1.0f - q.ay) + bot * q.ay) * (1.0f / 255.0f);
 }
 
 vec3f texture_triangle_mean(const mesh_texture *t, const float *uv0, const float *uv1,

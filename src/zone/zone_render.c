@@ -71,6 +71,23 @@ void zone_release(zt_renderer *r)
     r->forest = NULL;
 }
 
+/* Phase Two's context for the renderer's camera and levels (no terms or
+ * marks yet). */
+static void p2_ctx_begin(p2_ctx *c, zt_renderer *r)
+{
+    const zt_render_options *o = &r->options;
+    memset(c, 0, sizeof *c);
+    c->r = r;
+    c->f = (zone_forest *)r->forest;
+    cam_init(&c->c, &r->scene->camera);
+    vec3f mid = f3_add(c->c.to_screen, f3_scale(f3_add(c->c.right, c->c.down), 0.5f));
+    c->screen_dist = f3_length(mid);
+    c->pixel_angle = f3_length(c->c.right) / (float)c->c.width / c->screen_dist;
+    c->lo = o->level >= 0 ? o->level : 0;
+    c->hi = o->level >= 0 ? o->level : o->depth;
+    c->g = c->f->q.aa;
+}
+
 static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
                            int reference, zt_error *err)
 {
@@ -78,16 +95,7 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
     const zt_render_options *o = &r->options;
     double t0 = render_clock();
     p2_ctx c;
-    memset(&c, 0, sizeof c);
-    c.r = r;
-    c.f = f;
-    cam_init(&c.c, &r->scene->camera);
-    vec3f mid = f3_add(c.c.to_screen, f3_scale(f3_add(c.c.right, c.c.down), 0.5f));
-    c.screen_dist = f3_length(mid);
-    c.pixel_angle = f3_length(c.c.right) / (float)c.c.width / c.screen_dist;
-    c.lo = o->level >= 0 ? o->level : 0;
-    c.hi = o->level >= 0 ? o->level : o->depth;
-    c.g = f->q.aa;
+    p2_ctx_begin(&c, r);
     zt_status st = p2_terms_build(&c.terms, f, r, c.lo, c.hi, err);
     p2_marks marks = {NULL, NULL, NULL, 0, 0};
     if (st == ZT_OK && !p2_marks_build(&marks, &c))
@@ -151,12 +159,7 @@ zt_status zone_preview(zt_renderer *r, zt_image *sum, zt_render_stats *stats, zt
     const zt_render_options *o = &r->options;
     double t0 = render_clock();
     p2_ctx c;
-    memset(&c, 0, sizeof c);
-    c.r = r;
-    c.f = f;
-    cam_init(&c.c, &r->scene->camera);
-    c.lo = o->level >= 0 ? o->level : 0;
-    c.hi = o->level >= 0 ? o->level : o->depth;
+    p2_ctx_begin(&c, r);
     uint64_t rays = 0;
     zt_status st = p2_render_preview(&c, sum, &rays, err);
     if (stats) {
