@@ -183,18 +183,6 @@ static void test_floor_irradiance(void **state)
     }
 }
 
-static void copy_file(const char *from, const char *to)
-{
-    size_t n = 0;
-    char *data = test_read_file(from, &n);
-    assert_non_null(data);
-    FILE *fp = fopen(to, "wb");
-    assert_non_null(fp);
-    assert_int_equal(fwrite(data, 1, n, fp), n);
-    fclose(fp);
-    free(data);
-}
-
 static void test_unused_and_left_out(void **state)
 {
     (void)state;
@@ -220,8 +208,8 @@ static void test_unused_and_left_out(void **state)
 
     /* A texture that cannot be decoded: left out, counted and named; the
      * lamp then emits its factor times its strength all over. */
-    copy_file(MODELS "lamp.gltf", test_tmp_path("lamp.gltf"));
-    copy_file(MODELS "lamp.bin", test_tmp_path("lamp.bin"));
+    test_copy_file(MODELS "lamp.gltf", test_tmp_path("lamp.gltf"));
+    test_copy_file(MODELS "lamp.bin", test_tmp_path("lamp.bin"));
     test_write_file("lamp_e.png", "\x89PNG\r\n\x1a\n but cut short");
     char file[512];
     snprintf(file, sizeof file, "%s", test_tmp_path("lamp.gltf"));

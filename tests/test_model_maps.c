@@ -58,16 +58,9 @@ static double view_mean(zt_method method, const char *file, const char *transfor
              s.x, s.y, s.z, angle, file, transform[0] ? ", \"transform\": " : "", transform,
              eye.x, eye.y, eye.z, q.x, q.y, q.z);
     zt_scene *sc = test_scene_text(text, "model_maps");
-    zt_image *im = test_render_level(sc, method, 1, 1, spp);
-    double sum = 0;
-    int n = 3 * im->width * im->height;
-    for (int i = 0; i < n; i++) {
-        assert_true(isfinite(im->pixels[i]));
-        sum += im->pixels[i];
-    }
-    zt_image_release(im);
+    double mean = test_render_mean(sc, method, 1, 1, spp);
     zt_scene_release(sc);
-    return sum / n;
+    return mean;
 }
 
 /* ---- The rough and smooth halves of a metal. */
@@ -241,18 +234,6 @@ static void test_tilted_normals(void **state)
             }
 }
 
-static void copy_file(const char *from, const char *to)
-{
-    size_t n = 0;
-    char *data = test_read_file(from, &n);
-    assert_non_null(data);
-    FILE *fp = fopen(to, "wb");
-    assert_non_null(fp);
-    assert_int_equal(fwrite(data, 1, n, fp), n);
-    fclose(fp);
-    free(data);
-}
-
 /* ---- MTL: Ns as roughness, norm as the normal map. */
 
 /* The square of make_pbr_gltf.py as an OBJ (u along +x, v growing toward
@@ -308,7 +289,7 @@ static void test_mtl(void **state)
     }
     /* norm: tilt.gltf's normal map on the OBJ square reads as on the glTF
      * one. */
-    copy_file(MODELS "tilt_n.png", test_tmp_path("tilt_n.png"));
+    test_copy_file(MODELS "tilt_n.png", test_tmp_path("tilt_n.png"));
     snprintf(obj, sizeof obj, "%s", write_obj("norm", "newmtl m\nKd 1 1 1\nnorm tilt_n.png\n"));
     double th = 0.53 / 2 * PI / 180, disc = (1 + cos(th)) / 2;
     s = unit(mk(0.5, 0.7, 0.3));
@@ -360,7 +341,7 @@ static void test_maps_left_out(void **state)
     for (int i = 0; i < 2; i++) {
         char from[512];
         snprintf(from, sizeof from, "%s%s", MODELS, names[i]);
-        copy_file(from, test_tmp_path(names[i]));
+        test_copy_file(from, test_tmp_path(names[i]));
     }
     test_write_file("tilt_mr.png", "not a PNG");
     test_write_file("tilt_n.png", "\x89PNG\r\n\x1a\n but cut short");

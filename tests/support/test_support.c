@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "test_support.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -79,6 +80,31 @@ size_t test_obj_sheet(char *text, size_t len, size_t cap, int squares, double st
                                     c);
         }
     return len;
+}
+
+double test_render_mean(const zt_scene *s, zt_method method, int level, int depth, int spp)
+{
+    zt_image *im = test_render_level(s, method, level, depth, spp);
+    double sum = 0;
+    int n = 3 * im->width * im->height;
+    for (int i = 0; i < n; i++) {
+        assert_true(isfinite(im->pixels[i]));
+        sum += im->pixels[i];
+    }
+    zt_image_release(im);
+    return sum / n;
+}
+
+void test_copy_file(const char *from, const char *to)
+{
+    size_t n = 0;
+    char *data = test_read_file(from, &n);
+    assert_non_null(data);
+    FILE *fp = fopen(to, "wb");
+    assert_non_null(fp);
+    assert_int_equal(fwrite(data, 1, n, fp), n);
+    fclose(fp);
+    free(data);
 }
 
 char *test_read_file(const char *path, size_t *length)

@@ -35,6 +35,14 @@ const char *test_tmp_path(const char *name);
  * with the renderer's message on error. */
 zt_image *test_render_level(const zt_scene *s, zt_method method, int level, int depth, int spp);
 
+/* test_render_level's image, its mean over pixels and channels; fails the
+ * test on a value that is not finite. */
+double test_render_mean(const zt_scene *s, zt_method method, int level, int depth, int spp);
+
+/* Copies file `from` to `to` (a model and its textures into tmp_dir);
+ * fails the test when it cannot. */
+void test_copy_file(const char *from, const char *to);
+
 /* Writes text to tmp_dir/name and returns that path. */
 const char *test_write_file(const char *name, const char *text);
 
