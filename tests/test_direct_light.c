@@ -9,7 +9,9 @@
  * bounds, against a 64 times finer reference (which one 4 times coarser,
  * added up the other way, confirms); and split points, which always see
  * the light by rays, agree with the exact cut where few occluders or none
- * stand in the way.
+ * stand in the way.  The sky's gather shares its directions among split
+ * points the same way: a block of them sees, between them, what one point
+ * sees.
  *
  * Needs nothing from ../shared. */
 #include "test_support.h"
@@ -60,7 +62,11 @@ static const char *write_comb(void)
 #define SPHERE_LIGHT                                                                           \
     "{\"lightsphere\": {\"center\": [0, 10, 0], \"radius\": 1.5, \"emission\": [10, 10, 10]}},"
 
-/* The comb under `light`, one of the two above. */
+#define COLOUR_SKY "{\"sky\": {\"color\": [0.3, 0.5, 0.9]}},"
+#define MODEL_SKY "{\"sky\": {\"model\": \"preetham\", \"turbidity\": 3, " \
+                  "\"sun_direction\": [0.3, 1, 0.2]}},"
+
+/* The comb under `light`, one of those above. */
 static zt_renderer *comb_renderer(zt_scene **scene_out, const char *light)
 {
     char text[2048];
@@ -234,12 +240,81 @@ static void test_sphere_light_by_rays(void **state)
     zt_scene_release(scene);
 }
 
+/* The sky's gather (zone_sky_irradiance) at x for split point `split`. */
+static vec3 sky_at(const zt_renderer *r, vec3 x, vec3 n, int split)
+{
+    zone_trace t = {.f = r->forest, .r = r};
+    t.light_split = split;
+    return zone_sky_irradiance(&t, x, n);
+}
+
+/* The mean of a block of 4^levels split points' sky gathers, all at x,
+ * against one point's; returns the largest relative difference of a
+ * channel, and sets *spread to the largest one point's of the block. */
+static double sky_block(const zt_renderer *r, vec3 x, vec3 n, int levels, double *spread)
+{
+    vec3 one = sky_at(r, x, n, 0);
+    int count = 1 << (2 * levels);
+    vec3 mean = v3(0, 0, 0);
+    *spread = 0;
+    for (int i = 0; i < count; i++) {
+        vec3 e = sky_at(r, x, n, DIRECT_SPLIT(levels, i));
+        mean = v3_add(mean, v3_scale(e, 1.0 / count));
+        *spread = fmax(*spread, fabs(e.y - one.y) / one.y);
+    }
+    return fmax(fabs(mean.x - one.x) / one.x,
+                fmax(fabs(mean.y - one.y) / one.y, fabs(mean.z - one.z) / one.z));
+}
+
+/* Under the comb (part of the sky hidden) and beside it (none hidden),
+ * under a sky of one colour (fixed directions about the normal) and under
+ * the Preetham sky's map (directions drawn from it): a block of 4, 16 or 64
+ * split points together sees what one point sees, for one point's rays.
+ * Its points differ from each other (each sees its own directions) except
+ * under the open colour sky, where every direction escapes. */
+static void test_sky_splits_share_the_directions(void **state)
+{
+    (void)state;
+    const char *skies[2] = {COLOUR_SKY, MODEL_SKY};
+    vec3 up = v3(0, 1, 0), under = v3(0.01, 0, 0.02), beside = v3(30, 0, 0.5);
+    for (int k = 0; k < 2; k++) {
+        char light[256];
+        snprintf(light, sizeof light, "%s%s", skies[k], TRIANGLE_LIGHT);
+        zt_scene *scene;
+        zt_renderer *r = comb_renderer(&scene, light);
+        assert_true(r->forest->sky);
+        assert_int_equal(r->forest->sky_dir_count > 0, k == 1);
+        double worst = 0, spread_under = 0, spread_beside = 0;
+        for (int j = 1; j <= 3; j++) {
+            double s;
+            worst = fmax(worst, sky_block(r, under, up, j, &s));
+            spread_under = fmax(spread_under, s);
+            worst = fmax(worst, sky_block(r, beside, up, j, &s));
+            spread_beside = fmax(spread_beside, s);
+        }
+        vec3 hidden = sky_at(r, under, up, 0), open = sky_at(r, beside, up, 0);
+        printf("%s sky: under the comb %.1f%% of the open sky's light; blocks of split points "
+               "%.2g from one point at worst; a split point %.0f%% (under) and %.0f%% (beside) "
+               "from it at most\n",
+               k ? "Preetham" : "colour", 100 * hidden.y / open.y, worst, 100 * spread_under,
+               100 * spread_beside);
+        assert_true(hidden.y < 0.95 * open.y); /* the comb hides some */
+        assert_true(worst < 1e-5);             /* float sums in another order */
+        assert_true(spread_under > 0.01);      /* each point its own directions */
+        if (k == 0)
+            assert_true(spread_beside < 1e-6);
+        zt_renderer_release(r);
+        zt_scene_release(scene);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_query_stops_past_max),
         cmocka_unit_test(test_splits_share_the_rays),
         cmocka_unit_test(test_sphere_light_by_rays),
+        cmocka_unit_test(test_sky_splits_share_the_directions),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

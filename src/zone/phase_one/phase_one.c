@@ -59,26 +59,55 @@ static vec3 sky_open_irradiance(const zone_forest *f, vec3f n)
     return e;
 }
 
+/* The directions of `count` that a point takes: all of them, or for a
+ * split point (direct.h) every stride-th from its own first, so that the
+ * block's points take them all between them, each direction once, for one
+ * point's rays (points `stride` apart share when the block outnumbers
+ * them).  Which directions a point takes follows its place in the block,
+ * as its pieces of a light do. */
+static void sky_share(int split, int count, int *first, int *stride)
+{
+    *first = 0;
+    *stride = 1;
+    if (!split)
+        return;
+    int levels = split >> 16, index = (split & 0xffff) - 1;
+    int s = 1;
+    while (levels-- > 0 && s * 4 <= count)
+        s *= 4;
+    *first = index % s;
+    *stride = s;
+}
+
 vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 {
     const zone_forest *f = t->f;
     const rscene *rs = &t->r->rs;
+    int first, stride;
     if (f->sky_dir_count) {
         /* An environment map: the open-surface irradiance of the normal,
          * times the share of it that the importance-drawn directions find
-         * arriving (a ratio estimate: exact where nothing is in the way). */
+         * arriving (a ratio estimate: exact where nothing is in the way;
+         * the share's whole is taken over every direction, which costs no
+         * ray). */
         vec3f nf = v3_to_f3(n), o = ray_offset(v3_to_f3(x), nf);
         vec3f seen = f3_splat(0.0f), all = f3_splat(0.0f);
+        sky_share(t->light_split, f->sky_dir_count, &first, &stride);
         for (int k = 0; k < f->sky_dir_count; k++) {
             float c = f3_dot(nf, f->sky_dirs[k]);
             if (c <= 0.0f)
                 continue;
-            t->rays++;
             all = f3_madd(all, f->sky_weight[k], c);
+            if (k % stride != first)
+                continue;
+            t->rays++;
             vec3f tr = accel_transmittance(rs, o, f->sky_dirs[k], FLT_MAX, 1);
             if (!f3_is_black(tr))
                 seen = f3_madd(seen, f3_mul(f->sky_weight[k], tr), c);
         }
+        /* A split point's share of the directions stands for all of them:
+         * the block's points together see what one point's would. */
+        seen = f3_scale(seen, (float)stride);
         vec3 open = sky_open_irradiance(f, nf);
         return v3(all.x > 0.0f ? open.x * seen.x / all.x : open.x,
                   all.y > 0.0f ? open.y * seen.y / all.y : open.y,
@@ -88,17 +117,20 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
     v3_frame(n, &tt, &bb);
     vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
     vec3f open = f3_splat(0.0f);
-    for (int k = 0; k < f->q.gather; k++) {
+    sky_share(t->light_split, f->q.gather, &first, &stride);
+    int taken = 0;
+    for (int k = first; k < f->q.gather; k += stride) {
         const vec3 *dk = &f->dirs[k];
         vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
         open = f3_add(open, accel_transmittance(rs, o, v3_to_f3(d), FLT_MAX, 1));
         t->rays++;
+        taken++;
     }
     /* Each channel as sky x (pi x count / n): open holds whole counts
      * unless a pane is in the way. */
-    return v3(rs->sky.x * (3.14159265358979 * open.x / f->q.gather),
-              rs->sky.y * (3.14159265358979 * open.y / f->q.gather),
-              rs->sky.z * (3.14159265358979 * open.z / f->q.gather));
+    return v3(rs->sky.x * (3.14159265358979 * open.x / taken),
+              rs->sky.y * (3.14159265358979 * open.y / taken),
+              rs->sky.z * (3.14159265358979 * open.z / taken));
 }
 
 /* Mesh vertex nodes share a cut (node_groups.h) within GROUP_RADIUS x h
