@@ -192,8 +192,11 @@ typedef struct zone_trace {
     /* Exact direct light at a camera sample that shares the fallback's
      * rays with its neighbours (direct_irradiance_split), 0: alone. */
     int light_split;
-    zone_gather_slot gather; /* the camera sample's (zone_gather_irradiance
+    zone_gather_slot gather; /* the camera sample's (zone_mesh_irradiance
                                 and its rough lobes' directions) */
+    /* Gathers at the pixels' centres that a camera sample's may take
+     * instead of its own (phase_two/gather_cache.c); NULL: none. */
+    const struct zone_gather_cache *cache;
     /* Set by a rough lobe for the next ray it traces (zone_radiance resets
      * it): the lobe's density of that direction, and the point it left, so
      * that the light it meets is weighed against the lobe's light samples
@@ -258,7 +261,7 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n);
 vec3 zone_lights_at(zone_trace *t, int receiver, vec3 x, vec3 n);
 
 /* Whether a camera path's diffuse light of levels >= 2 at primitive prim
- * is gathered (zone_gather_irradiance) rather than read from its nodes. */
+ * is gathered (zone_mesh_irradiance) rather than read from its nodes. */
 static inline int zone_gathers(const rscene *rs, int prim)
 {
     return prim >= rs->part_count;
@@ -266,8 +269,19 @@ static inline int zone_gathers(const rscene *rs, int prim)
 /* Irradiance of level `level` (>= 1) at x on a mesh (nf: the geometric
  * normal on the side seen, n: the shading normal), gathered from the
  * forest over cosine-weighted directions: the level's radiance where they
- * meet the scene (phase_two/gather.c). */
-vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level);
+ * meet the scene (phase_two/gather.c).  *inv_dist, if not NULL, gets the
+ * mean over the directions of 1 / the distance their rays went. */
+vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
+                            double *inv_dist);
+/* The same at a camera path's point x on side `side` of mesh primitive
+ * prim, with the light kept apart from gathers (zone_specular_map_read)
+ * added: from the gathers at nearby pixels' centres where they hold for x
+ * (zone_gather_cache_read), else gathered at x. */
+vec3 zone_mesh_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level, int prim,
+                          int side);
+/* The gathers at the centres of the pixels around the camera sample's
+ * pixel that hold for x (normal nf), blended: returns 0 when none does. */
+int zone_gather_cache_read(const zone_trace *t, vec3f x, vec3f nf, int level, vec3 *e);
 
 enum {
     ZR_EXACT_DIRECT = 1, /* level 1 from the analytic direct term, not maps */

@@ -102,6 +102,11 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
         st = zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixel marks");
     c.marks = &marks;
     uint64_t rays = 0;
+    struct zone_gather_cache cache;
+    memset(&cache, 0, sizeof cache);
+    if (st == ZT_OK && !p2_gather_cache_build(&cache, &c, &rays))
+        st = zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixels' gathers");
+    c.cache = &cache;
     /* Split over processes, each renders its rows into an image of its
      * own, the merge joins them, and the whole is added to sum: the same
      * additions, in the same order, as one process makes. */
@@ -128,6 +133,7 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
     }
     p2_terms_free(&c.terms);
     p2_marks_free(&marks);
+    p2_gather_cache_free(&cache);
     if (stats) {
         stats->threads = render_thread_count(o->threads);
         /* Phase One's rays are charged to the first image, unless the

@@ -28,7 +28,8 @@
 #include "util/vec3_convert.h"
 #include "zone/zone.h"
 
-vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
+vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
+                            double *inv_dist)
 {
     int count = t->gather.count > 1 ? t->gather.count : 1;
     int index = t->gather.count > 1 ? t->gather.index : 0;
@@ -77,6 +78,7 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
         memo->origin[slot.sample] = o;
     }
     vec3 sum = v3(0, 0, 0);
+    double inv_sum = 0;
     for (int k = 0; k < k_max; k++) {
         double u, v;
         r2_point(first + (double)count * k, &u, &v);
@@ -87,12 +89,16 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
         if (f3_dot(d, nf) <= 0.0f)
             continue;
         d = f3_normalize(d);
-        if (kept) {
-            if (!reuse) {
-                kept[k] = accel_intersect(&t->r->rs, o, d);
+        hit own;
+        if (kept || inv_dist) {
+            hit *h = kept ? &kept[k] : &own;
+            if (!kept || !reuse) {
+                *h = accel_intersect(&t->r->rs, o, d);
                 t->rays++;
             }
-            t->first_hit = &kept[k];
+            t->first_hit = h;
+            if (h->part >= 0 && h->t > 0.0f)
+                inv_sum += 1.0 / h->t;
         }
         sum = v3_add(sum, zone_radiance(t, o, d, level, level, ZR_NO_GLINT | ZR_NO_CAUSTIC,
                                         NULL, 0));
@@ -100,5 +106,16 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level)
     t->light_split = save;
     t->gather = slot;
     t->sample_share = share;
+    if (inv_dist)
+        *inv_dist = inv_sum / k_max;
     return v3_scale(sum, 3.14159265358979 / k_max);
+}
+
+vec3 zone_mesh_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level, int prim,
+                          int side)
+{
+    vec3 e;
+    if (!zone_gather_cache_read(t, x, nf, level, &e))
+        e = zone_gather_irradiance(t, x, nf, n, level, NULL);
+    return v3_add(e, zone_specular_map_read(t->f, &t->r->rs, level, prim, side, f3_to_v3(x)));
 }

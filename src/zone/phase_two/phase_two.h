@@ -34,6 +34,7 @@
 #include <stdint.h>
 
 #include "camera/camera.h"
+#include "render/prim.h"
 #include "zone/zone.h"
 
 /* The samples a pixel has at most but for many surfaces in it (whose
@@ -117,6 +118,7 @@ typedef struct p2_ctx {
     float pixel_angle, screen_dist;
     p2_terms terms;
     const struct p2_marks *marks; /* what the pixels' own rays may miss */
+    const struct zone_gather_cache *cache; /* gathers at pixel centres */
 } p2_ctx;
 
 /* What the pixels' own rays may miss, found from the eye
@@ -154,6 +156,35 @@ static inline void p2_row_pixel(const p2_row *row, int x, int y, p2_pixel *px)
     px->light_cover = row->light_cover ? row->light_cover + row->light_first[x] : NULL;
     px->nlights = (int)(row->light_first[x + 1] - row->light_first[x]);
 }
+
+/* The first hit of a camera sample, as zone_radiance sees it. */
+typedef struct p2_surface {
+    rs_part tmp;
+    const rs_part *p;
+    const rs_object *m;
+    vec3f xf, nf;       /* the point and the geometric normal facing the ray */
+    vec3 x, n, color;   /* n: the shading normal */
+    int back;
+    rs_shade sh;        /* m may point into it (a material with maps) */
+} p2_surface;
+void p2_surface_of(const rscene *rs, const p2_sample *s, p2_surface *sf);
+
+/* Gathers shared between neighbouring pixels (gather_cache.c): at each
+ * pixel's centre, when it sees a mesh's diffuse surface, the gathers of
+ * the levels the image reads (E_first .. E_first+levels-1), where they
+ * were taken and how far their rays went. */
+struct zone_gather_cache {
+    int width, height;
+    int first, levels;
+    unsigned char *have;    /* per pixel: a record */
+    vec3f *x, *n;           /* its point and geometric normal (facing the eye) */
+    float *r;               /* its rays' harmonic mean distance */
+    float *e;               /* per pixel and level: the gathered irradiance */
+};
+/* Builds the records the rows this process renders may read (0: none
+ * needed, the cache stays empty).  Returns 0 when out of memory. */
+int p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, uint64_t *rays);
+void p2_gather_cache_free(struct zone_gather_cache *gc);
 
 /* Terms (phase_two_terms.c). */
 zt_status p2_terms_build(p2_terms *t, const zone_forest *f, const zt_renderer *r, int lo,

@@ -127,10 +127,8 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
             l++;
         }
         if (exact_direct && zone_gathers(rs, h.part)) {
-            for (; l <= hi; l++) {
-                e = v3_add(e, zone_gather_irradiance(t, xf, nf, n, l - 1));
-                e = v3_add(e, zone_specular_map_read(t->f, rs, l - 1, h.part, back, x));
-            }
+            for (; l <= hi; l++)
+                e = v3_add(e, zone_mesh_irradiance(t, xf, nf, n, l - 1, h.part, back));
         } else if (l <= hi) {
             /* The maps of the remaining levels, read at once. */
             e = zone_map_read_levels(t->f, rs, l - 1, hi - 1, h.part, back, x, e);

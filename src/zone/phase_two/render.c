@@ -92,7 +92,7 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
     volatile int failed = 0; /* set by any thread that runs out of memory */
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
-        zone_trace t = {.f = c->f, .r = c->r};
+        zone_trace t = {.f = c->f, .r = c->r, .cache = c->cache};
         /* The gathers' hits, kept from a pixel's one level to the next:
          * the same rays (gather.c). */
         t.memo = malloc(sizeof *t.memo);
@@ -146,7 +146,7 @@ zt_status p2_render_reference(const p2_ctx *c, zt_image *sum, uint64_t *rays_out
     volatile int failed = 0; /* set by any thread that runs out of memory */
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
-        zone_trace t = {.f = c->f, .r = c->r};
+        zone_trace t = {.f = c->f, .r = c->r, .cache = c->cache};
         p2_row row;
         memset(&row, 0, sizeof row);
 #pragma omp for schedule(dynamic, 1)
@@ -299,7 +299,7 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
         /* Small terms stay on this thread: waking the others costs more. */
 #pragma omp parallel num_threads(threads) reduction(+ : rays) if (n >= 256)
         {
-            zone_trace t = {.f = c->f, .r = c->r};
+            zone_trace t = {.f = c->f, .r = c->r, .cache = c->cache};
             int done = 0;
 #pragma omp for schedule(dynamic, 16)
             for (int i = 0; i < n; i++) {

@@ -122,18 +122,7 @@ void p2_terms_free(p2_terms *t)
     memset(t, 0, sizeof *t);
 }
 
-/* The first hit of a camera sample, as zone_radiance sees it. */
-typedef struct surface {
-    rs_part tmp;
-    const rs_part *p;
-    const rs_object *m;
-    vec3f xf, nf;       /* the point and the geometric normal facing the ray */
-    vec3 x, n, color;   /* n: the shading normal */
-    int back;
-    rs_shade sh;        /* m may point into it (a material with maps) */
-} surface;
-
-static void surface_of(const rscene *rs, const p2_sample *s, surface *sf)
+void p2_surface_of(const rscene *rs, const p2_sample *s, p2_surface *sf)
 {
     sf->p = rs_prim(rs, s->part, &sf->tmp);
     sf->m = &rs->objects[sf->p->object];
@@ -157,8 +146,8 @@ static void surface_of(const rscene *rs, const p2_sample *s, surface *sf)
 /* Level 1 diffuse light: every light exactly, and the sky. */
 static vec3 direct_value(zone_trace *t, const p2_sample *s)
 {
-    surface sf;
-    surface_of(&t->r->rs, s, &sf);
+    p2_surface sf;
+    p2_surface_of(&t->r->rs, s, &sf);
     vec3 e = zone_lights_at(t, s->part, sf.x, sf.n);
     if (t->f->sky)
         e = v3_add(e, zone_sky_irradiance(t, sf.x, sf.n));
@@ -169,13 +158,11 @@ static vec3 direct_value(zone_trace *t, const p2_sample *s)
  * mesh gathered. */
 static vec3 map_value(zone_trace *t, const p2_term *term, const p2_sample *s)
 {
-    surface sf;
-    surface_of(&t->r->rs, s, &sf);
+    p2_surface sf;
+    p2_surface_of(&t->r->rs, s, &sf);
     const rscene *rs = &t->r->rs;
     vec3 e = zone_gathers(rs, s->part)
-                 ? v3_add(zone_gather_irradiance(t, sf.xf, sf.nf, sf.n, term->level - 1),
-                          zone_specular_map_read(t->f, rs, term->level - 1, s->part, sf.back,
-                                                 sf.x))
+                 ? zone_mesh_irradiance(t, sf.xf, sf.nf, sf.n, term->level - 1, s->part, sf.back)
                  : zone_map_read(t->f, rs, term->level - 1, s->part, sf.back, sf.x);
     return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
 }
@@ -184,8 +171,8 @@ static vec3 map_value(zone_trace *t, const p2_term *term, const p2_sample *s)
  * the reflected ray (and, for glass, the refracted one). */
 static vec3 specular_value(zone_trace *t, const p2_term *term, const p2_sample *s)
 {
-    surface sf;
-    surface_of(&t->r->rs, s, &sf);
+    p2_surface sf;
+    p2_surface_of(&t->r->rs, s, &sf);
     const rs_object *m = sf.m;
     int l = term->level;
     vec3f d = s->d, wo = f3_neg(d), ns = v3_to_f3(sf.n);
