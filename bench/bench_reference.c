@@ -3,6 +3,7 @@
  *
  *   bench_reference SCENE -o OUT.pfm [--size WxH] [--level L | --depth D]
  *                   [--spp N] [--seed S] [--noise NOISE.pfm] [--threads T]
+ *                   [--motions FILE --time T [--motion-seed S]]
  *
  * A reference's error is the relative RMSE of the whole image, so what
  * matters is the sum over pixels of each pixel's variance.  A few pixels
@@ -22,7 +23,10 @@
  * noise of the whole image is printed.
  *
  * The samples are the path tracer's own (path_trace_sample, the same
- * sampler and levels as `zonetrace render --method path`). */
+ * sampler and levels as `zonetrace render --method path`).  With --motions
+ * the scene is the one `zonetrace render --motions FILE --time T` renders
+ * (camera path included), so an animation's frames get references; the
+ * brownian walks follow --motion-seed as render's follow its --seed. */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -74,16 +78,44 @@ static void pixel_samples(job *j, int x, int y, uint32_t first, uint32_t count,
 static int usage(void)
 {
     fprintf(stderr, "usage: bench_reference SCENE -o OUT.pfm [--size WxH] [--level L | --depth D]\n"
-                    "                       [--spp N] [--seed S] [--noise NOISE.pfm] [--threads T]\n");
+                    "                       [--spp N] [--seed S] [--noise NOISE.pfm] [--threads T]\n"
+                    "                       [--motions FILE --time T [--motion-seed S]]\n");
     return 1;
+}
+
+/* The scene of `zonetrace render --motions FILE --time T` (its camera on
+ * scene0's pixel grid), replacing scene0; NULL after a message. */
+static zt_scene *scene_at_time(zt_scene *scene0, const char *motions_path, double t,
+                               uint64_t seed)
+{
+    zt_error err;
+    zt_error_clear(&err);
+    zt_motions *m = NULL;
+    zt_scene *moved = NULL;
+    if (zt_motions_load_file(motions_path, &m, &err) == ZT_OK &&
+        zt_motions_check(m, scene0, &err) == ZT_OK) {
+        moved = zt_scene_clone(scene0);
+        if (!moved)
+            snprintf(err.message, sizeof err.message, "out of memory");
+        else if (zt_motions_apply(m, scene0, t, seed, moved, &err) != ZT_OK) {
+            zt_scene_release(moved);
+            moved = NULL;
+        }
+    }
+    if (!moved)
+        fprintf(stderr, "bench_reference: %s\n", err.message);
+    zt_motions_release(m);
+    zt_scene_release(scene0);
+    return moved;
 }
 
 int main(int argc, char **argv)
 {
-    const char *scene_path = NULL, *out = NULL, *noise_out = NULL;
+    const char *scene_path = NULL, *out = NULL, *noise_out = NULL, *motions_path = NULL;
     int width = 0, height = 0, level = -1, depth = 16, threads = 0;
     long spp = 4096;
-    unsigned long long seed = 0;
+    unsigned long long seed = 0, motion_seed = 0;
+    double time = -1.0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         int more = i + 1 < argc;
@@ -104,12 +136,19 @@ int main(int argc, char **argv)
             seed = strtoull(argv[++i], NULL, 10);
         else if (!strcmp(a, "--threads") && more)
             threads = atoi(argv[++i]);
+        else if (!strcmp(a, "--motions") && more)
+            motions_path = argv[++i];
+        else if (!strcmp(a, "--time") && more)
+            time = atof(argv[++i]);
+        else if (!strcmp(a, "--motion-seed") && more)
+            motion_seed = strtoull(argv[++i], NULL, 10);
         else if (a[0] != '-' && !scene_path)
             scene_path = a;
         else
             return usage();
     }
-    if (!scene_path || !out || spp < 8 * BATCHES || spp > (1L << 30) || depth < 0 || level > 64)
+    if (!scene_path || !out || spp < 8 * BATCHES || spp > (1L << 30) || depth < 0 || level > 64 ||
+        !motions_path != (time < 0.0))
         return usage();
 
     zt_error err;
@@ -125,6 +164,8 @@ int main(int argc, char **argv)
         return 1;
     }
     zt_scene_set_camera(scene, &zc);
+    if (motions_path && !(scene = scene_at_time(scene, motions_path, time, motion_seed)))
+        return 3;
     zt_render_options o = zt_render_options_default();
     zt_renderer *r = NULL;
     if (zt_renderer_create(scene, &o, &r, &err) != ZT_OK) {
