@@ -115,7 +115,8 @@ int main(int argc, char **argv)
     int width = 0, height = 0, level = -1, depth = 16, threads = 0;
     long spp = 4096;
     unsigned long long seed = 0, motion_seed = 0;
-    double time = -1.0;
+    double time = 0.0;
+    int have_time = 0; /* motions may have negative times */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         int more = i + 1 < argc;
@@ -138,8 +139,10 @@ int main(int argc, char **argv)
             threads = atoi(argv[++i]);
         else if (!strcmp(a, "--motions") && more)
             motions_path = argv[++i];
-        else if (!strcmp(a, "--time") && more)
+        else if (!strcmp(a, "--time") && more) {
             time = atof(argv[++i]);
+            have_time = 1;
+        }
         else if (!strcmp(a, "--motion-seed") && more)
             motion_seed = strtoull(argv[++i], NULL, 10);
         else if (a[0] != '-' && !scene_path)
@@ -148,7 +151,7 @@ int main(int argc, char **argv)
             return usage();
     }
     if (!scene_path || !out || spp < 8 * BATCHES || spp > (1L << 30) || depth < 0 || level > 64 ||
-        !motions_path != (time < 0.0))
+        !motions_path != !have_time)
         return usage();
 
     zt_error err;
