@@ -104,8 +104,8 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
     uint64_t rays = 0;
     struct zone_gather_cache cache;
     memset(&cache, 0, sizeof cache);
-    if (st == ZT_OK && !p2_gather_cache_build(&cache, &c, &rays))
-        st = zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixels' gathers");
+    if (st == ZT_OK)
+        st = p2_gather_cache_build(&cache, &c, &rays, err);
     c.cache = &cache;
     /* Split over processes, each renders its rows into an image of its
      * own, the merge joins them, and the whole is added to sum: the same

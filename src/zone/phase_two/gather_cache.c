@@ -21,9 +21,10 @@
  * per pixel against the path reference; the engine room 0.871% -> 0.859%
  * (BENCHMARKS.md).
  *
- * The records are built for every row the process renders and the rows
- * next to them, before any pixel is shaded, by both strategies alike: the
- * image stays the same bit for bit at any thread count, strategy and
+ * The records are built before any pixel is shaded, by both strategies
+ * alike; split over processes, each builds those of its own rows and the
+ * processes exchange them (a sample reads its neighbouring rows' too), so
+ * the image stays the same bit for bit at any thread count, strategy and
  * process count. */
 #include <math.h>
 #include <stdlib.h>
@@ -31,20 +32,13 @@
 
 #include "geom/accel.h"
 #include "render/share.h"
+#include "util/error.h"
 #include "util/vec3_convert.h"
 #include "zone/phase_two/phase_two.h"
 
 /* Ward's eps below which a record holds.  Ward recommends 0.1 to 0.2 for
  * records extrapolated over a region; these are one pixel away. */
 #define CACHE_EPS 0.2
-
-static int needs_row(const zt_render_options *o, int y, int height)
-{
-    for (int dy = -1; dy <= 1; dy++)
-        if (y + dy >= 0 && y + dy < height && share_owns(o, y + dy))
-            return 1;
-    return 0;
-}
 
 /* The record at pixel (px, py): 1 if its centre sees a mesh's diffuse
  * surface. */
@@ -88,7 +82,8 @@ static int record_at(const p2_ctx *c, zone_trace *t, struct zone_gather_cache *g
     return 1;
 }
 
-int p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, uint64_t *rays_out)
+zt_status p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, uint64_t *rays_out,
+                                zt_error *err)
 {
     memset(gc, 0, sizeof *gc);
     const zt_render_options *o = &c->r->options;
@@ -96,21 +91,23 @@ int p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, uint64_
     /* Levels gathered: E_{l-1} for the image's levels l >= 2, on meshes. */
     int first = c->lo > 2 ? c->lo - 1 : 1, last = c->hi - 1;
     if (last < first || rs->prim_count <= rs->part_count)
-        return 1;
+        return ZT_OK;
     int w = c->c.width, h = c->c.height;
     size_t n = (size_t)w * (size_t)h;
     gc->width = w;
     gc->height = h;
     gc->first = first;
     gc->levels = last - first + 1;
+    /* Zero where nothing is written: the processes' exchange joins the
+     * bytes each wrote. */
     gc->have = calloc(n, 1);
-    gc->x = malloc(n * sizeof *gc->x);
-    gc->n = malloc(n * sizeof *gc->n);
-    gc->r = malloc(n * sizeof *gc->r);
-    gc->e = malloc(n * (size_t)gc->levels * 3 * sizeof *gc->e);
+    gc->x = calloc(n, sizeof *gc->x);
+    gc->n = calloc(n, sizeof *gc->n);
+    gc->r = calloc(n, sizeof *gc->r);
+    gc->e = calloc(n * (size_t)gc->levels * 3, sizeof *gc->e);
     if (!gc->have || !gc->x || !gc->n || !gc->r || !gc->e) {
         p2_gather_cache_free(gc);
-        return 0;
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixels' gathers");
     }
     int threads = render_thread_count(o->threads);
     uint64_t rays = 0;
@@ -127,7 +124,7 @@ int p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, uint64_
             t.memo->pixel = UINT32_MAX;
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < h; y++) {
-            if (failed || !needs_row(o, y, h))
+            if (failed || !share_owns(o, y))
                 continue;
             for (int x = 0; x < w; x++)
                 gc->have[(size_t)y * (size_t)w + (size_t)x] =
@@ -137,11 +134,23 @@ int p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, uint64_
         rays += t.rays;
     }
     *rays_out += rays;
-    if (failed) {
-        p2_gather_cache_free(gc);
-        return 0;
+    zt_status st = failed ? zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixels' gathers")
+                          : ZT_OK;
+    if (st == ZT_OK && share_ranks(o) > 1) {
+        size_t levels = (size_t)gc->levels;
+        st = share_merge(o, gc->have, n, err);
+        if (st == ZT_OK)
+            st = share_merge(o, gc->x, n * sizeof *gc->x, err);
+        if (st == ZT_OK)
+            st = share_merge(o, gc->n, n * sizeof *gc->n, err);
+        if (st == ZT_OK)
+            st = share_merge(o, gc->r, n * sizeof *gc->r, err);
+        if (st == ZT_OK)
+            st = share_merge(o, gc->e, n * levels * 3 * sizeof *gc->e, err);
     }
-    return 1;
+    if (st != ZT_OK)
+        p2_gather_cache_free(gc);
+    return st;
 }
 
 void p2_gather_cache_free(struct zone_gather_cache *gc)

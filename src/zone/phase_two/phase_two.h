@@ -181,9 +181,11 @@ struct zone_gather_cache {
     float *r;               /* its rays' harmonic mean distance */
     float *e;               /* per pixel and level: the gathered irradiance */
 };
-/* Builds the records the rows this process renders may read (0: none
- * needed, the cache stays empty).  Returns 0 when out of memory. */
-int p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, uint64_t *rays);
+/* Builds the records (none when the image gathers nothing: the cache
+ * stays empty); split over processes, each builds its rows' and they are
+ * exchanged. */
+zt_status p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, uint64_t *rays,
+                                zt_error *err);
 void p2_gather_cache_free(struct zone_gather_cache *gc);
 
 /* Terms (phase_two_terms.c). */
