@@ -295,6 +295,8 @@ int cli_animate(const char *scene_path, const zt_render_options *options,
             frames_done++;
             if ((!quiet && !verbose) || (ranks > 1 && verbose))
                 fprintf(stderr, ", %.2f s\n", stats.seconds);
+            else if (verbose) /* its name went before the progress lines */
+                fprintf(stderr, "frame %d/%d: %.2f s\n", kj + 1, anim->frames, stats.seconds);
             cli_report_stop(opt, &stats, quiet);
         }
         zt_image_release(img);
