@@ -116,7 +116,7 @@ int main(int argc, char **argv)
     long spp = 4096;
     unsigned long long seed = 0, motion_seed = 0;
     double time = 0.0;
-    int have_time = 0; /* motions may have negative times */
+    int have_time = 0; /* --time goes with --motions (the motions check its value) */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         int more = i + 1 < argc;

@@ -49,11 +49,11 @@ uint64_t memory_estimate_render(const zt_scene *sc, const zt_render_options *o)
     uint64_t pixels = (uint64_t)sc->camera.width * (uint64_t)sc->camera.height;
     uint64_t per_pixel = o->method == ZT_METHOD_ZONE ? ZONE_PER_PIXEL : PATH_PER_PIXEL;
     /* The zone tracer's gathers at pixel centres on meshes
-     * (phase_two/gather_cache.c): a point, a normal, a distance and a flag,
-     * and an irradiance per level gathered. */
+     * (phase_two/gather_cache.c): a point, a normal and a distance, and an
+     * irradiance per level gathered. */
     if (o->method == ZT_METHOD_ZONE && scene_mesh_triangles(sc) > 0) {
         int gathered = o->level >= 0 ? 1 : o->depth - 1;
-        per_pixel += 29 + 12 * (uint64_t)(gathered > 0 ? gathered : 0);
+        per_pixel += 28 + 12 * (uint64_t)(gathered > 0 ? gathered : 0);
     }
     return pixels * per_pixel + (uint64_t)scene_mesh_triangles(sc) * PER_TRIANGLE +
            (uint64_t)sc->part_count * PER_PART;

@@ -547,7 +547,7 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
     int fan = p->n - 2, k = 0;
     while (fan * (1 << (2 * k)) < count && k < 6)
         k++;
-    int levels = split ? split >> 16 : 0, index = split ? (split & 0xffff) - 1 : 0;
+    int levels = DIRECT_SPLIT_LEVELS(split), index = DIRECT_SPLIT_INDEX(split);
     if (levels > k)
         levels = k;
     k -= levels;

@@ -41,9 +41,9 @@
  * and 0.868% per pixel against the path reference. */
 #define CACHE_EPS 0.2
 
-/* The record at pixel (px, py): 1 if its centre sees a mesh's diffuse
- * surface. */
-static int record_at(const p2_ctx *c, zone_trace *t, struct zone_gather_cache *gc, int px,
+/* The record at pixel (px, py), if its centre sees a mesh's diffuse
+ * surface (else its R stays 0: no record). */
+static void record_at(const p2_ctx *c, zone_trace *t, struct zone_gather_cache *gc, int px,
                      int py)
 {
     const rscene *rs = &c->r->rs;
@@ -54,13 +54,13 @@ static int record_at(const p2_ctx *c, zone_trace *t, struct zone_gather_cache *g
     hit h = accel_intersect(rs, s.o, s.d);
     t->rays++;
     if (h.part < 0 || !zone_gathers(rs, h.part))
-        return 0;
+        return;
     s.t = h.t;
     s.part = h.part;
     p2_surface sf;
     p2_surface_of(rs, &s, &sf);
     if (sf.m->weight[LOBE_DIFFUSE] <= 0.0f || sf.m->is_light)
-        return 0;
+        return;
     /* The directions the pixel's one sample would take. */
     t->gather = (zone_gather_slot){(uint32_t)i, 0, 1, 0, 1};
     double inv_dist = 0;
@@ -80,7 +80,6 @@ static int record_at(const p2_ctx *c, zone_trace *t, struct zone_gather_cache *g
     /* Every ray escaping: R is unbounded, the light the same everywhere
      * but for what the surface itself hides. */
     gc->r[i] = inv_dist > 0 ? (float)(1.0 / inv_dist) : INFINITY;
-    return 1;
 }
 
 zt_status p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, uint64_t *rays_out,
@@ -101,12 +100,11 @@ zt_status p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, u
     gc->levels = last - first + 1;
     /* Zero where nothing is written: the processes' exchange joins the
      * bytes each wrote. */
-    gc->have = calloc(n, 1);
     gc->x = calloc(n, sizeof *gc->x);
     gc->n = calloc(n, sizeof *gc->n);
     gc->r = calloc(n, sizeof *gc->r);
     gc->e = calloc(n * (size_t)gc->levels * 3, sizeof *gc->e);
-    if (!gc->have || !gc->x || !gc->n || !gc->r || !gc->e) {
+    if (!gc->x || !gc->n || !gc->r || !gc->e) {
         p2_gather_cache_free(gc);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixels' gathers");
     }
@@ -128,8 +126,7 @@ zt_status p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, u
             if (failed || !share_owns(o, y))
                 continue;
             for (int x = 0; x < w; x++)
-                gc->have[(size_t)y * (size_t)w + (size_t)x] =
-                    (unsigned char)record_at(c, &t, gc, x, y);
+                record_at(c, &t, gc, x, y);
         }
         free(t.memo);
         rays += t.rays;
@@ -139,9 +136,7 @@ zt_status p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, u
                           : ZT_OK;
     if (st == ZT_OK && share_ranks(o) > 1) {
         size_t levels = (size_t)gc->levels;
-        st = share_merge(o, gc->have, n, err);
-        if (st == ZT_OK)
-            st = share_merge(o, gc->x, n * sizeof *gc->x, err);
+        st = share_merge(o, gc->x, n * sizeof *gc->x, err);
         if (st == ZT_OK)
             st = share_merge(o, gc->n, n * sizeof *gc->n, err);
         if (st == ZT_OK)
@@ -156,7 +151,6 @@ zt_status p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, u
 
 void p2_gather_cache_free(struct zone_gather_cache *gc)
 {
-    free(gc->have);
     free(gc->x);
     free(gc->n);
     free(gc->r);
@@ -167,7 +161,7 @@ void p2_gather_cache_free(struct zone_gather_cache *gc)
 int zone_gather_cache_read(const zone_trace *t, vec3f x, vec3f nf, int level, vec3 *e)
 {
     const struct zone_gather_cache *gc = t->cache;
-    if (!gc || !gc->have || !t->gather.count || level < gc->first ||
+    if (!gc || !gc->r || !t->gather.count || level < gc->first ||
         level >= gc->first + gc->levels)
         return 0;
     /* A mesh detail pixel's 8 x 8 samples are there to find what lies
@@ -187,7 +181,7 @@ int zone_gather_cache_read(const zone_trace *t, vec3f x, vec3f nf, int level, ve
             if (xx < 0 || xx >= w)
                 continue;
             size_t i = (size_t)y * (size_t)w + (size_t)xx;
-            if (!gc->have[i])
+            if (!(gc->r[i] > 0.0f)) /* no record */
                 continue;
             double cosn = f3_dot(nf, gc->n[i]);
             if (cosn <= 0.0)

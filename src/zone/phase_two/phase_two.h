@@ -176,9 +176,10 @@ void p2_surface_of(const rscene *rs, const p2_sample *s, p2_surface *sf);
 struct zone_gather_cache {
     int width, height;
     int first, levels;
-    unsigned char *have;    /* per pixel: a record */
-    vec3f *x, *n;           /* its point and geometric normal (facing the eye) */
-    float *r;               /* its rays' harmonic mean distance */
+    vec3f *x, *n;           /* per pixel: the record's point and geometric
+                               normal (facing the eye) */
+    float *r;               /* its rays' harmonic mean distance (INFINITY:
+                               every ray escaped); 0: no record */
     float *e;               /* per pixel and level: the gathered irradiance */
 };
 /* Builds the records (none when the image gathers nothing: the cache
