@@ -170,6 +170,8 @@ static void print_zone_stats(const zt_render_stats *s, const char *loaded_from)
                 (unsigned long long)s->cuts_capped,
                 s->cuts ? 100.0 * (double)s->cuts_capped / (double)s->cuts : 0.0,
                 (unsigned long long)s->cuts_shared);
+    if (s->sky_portals)
+        fprintf(stderr, "sky portals: %d windows of panes\n", s->sky_portals);
     fprintf(stderr, "forest memory: %llu bytes (%.1f MiB: zones, occluder lists and maps)\n",
             (unsigned long long)s->memory_bytes, s->memory_bytes / 1048576.0);
     if (s->forest_loaded)

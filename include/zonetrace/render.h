@@ -157,6 +157,8 @@ typedef struct zt_render_stats {
                               (a mesh's vertex nodes in groups) */
     uint64_t nodes_gathered; /* zone, Phase One: nodes whose transfer was
                               gathered instead of cut (docs/zone-tracer.md) */
+    int sky_portals;       /* zone: windows whose panes the sky's gather
+                              aims at (docs/zone-tracer.md) */
     int forest_loaded;     /* zone: the forest came from options.forest_file
                               (phase_one_seconds is then the time to read it) */
     /* zt_render */

@@ -13,6 +13,14 @@
 vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
                           int target_is_background)
 {
+    return accel_transmittance_panes(rs, o, d, dist, target_is_background, NULL);
+}
+
+vec3f accel_transmittance_panes(const rscene *rs, vec3f o, vec3f d, float dist,
+                                int target_is_background, int *first_pane)
+{
+    if (first_pane)
+        *first_pane = -1;
     if (!rs->pane_count)
         return f3_splat(accel_occluded(rs, o, d, dist, target_is_background) ? 0.0f : 1.0f);
     vec3f tr = f3_splat(1.0f);
@@ -34,6 +42,8 @@ vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
                 return p->background ? tr : f3_splat(0.0f);
             break;
         }
+        if (first_pane && *first_pane < 0 && m->thin)
+            *first_pane = h.part;
         vec3f x = shape_hit_point(p, o, d, h.t);
         vec3f ng = shape_normal(p, x);
         float c = f3_dot(ng, d);

@@ -17,6 +17,12 @@
 vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
                           int target_is_background);
 
+/* accel_transmittance, and in *first_pane the primitive of the first thin
+ * pane (a material with "thin") the ray crosses, -1 when it crosses none.
+ * Partial coverage does not count as a pane. */
+vec3f accel_transmittance_panes(const rscene *rs, vec3f o, vec3f d, float dist,
+                                int target_is_background, int *first_pane);
+
 /* The same as one number (the channels' mean), for the zone tracer's
  * scalar visibility. */
 static inline float accel_transmittance_mean(const rscene *rs, vec3f o, vec3f d, float dist,

@@ -64,6 +64,11 @@ int distant_in_sun(const rs_distant *d, vec3f w)
     return d->sun && f3_dot(w, d->sun_dir) > 0.0f && f3_dot(c, c) <= d->sun_sin2;
 }
 
+vec3f distant_map_radiance(const rs_distant *d, vec3f w)
+{
+    return d->map ? f3_scale(env_map_radiance(d->map, to_map(d, w)), d->strength) : f3_splat(0.0f);
+}
+
 vec3f distant_radiance(const rs_distant *d, vec3f w)
 {
     vec3f l = f3_splat(0.0f);

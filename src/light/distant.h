@@ -16,6 +16,9 @@ void distant_build(rs_distant *d, const zt_scene *scene);
 /* Radiance arriving from unit direction w (map and sun). */
 vec3f distant_radiance(const rs_distant *d, vec3f w);
 
+/* Radiance arriving from unit direction w from the map alone (no sun). */
+vec3f distant_map_radiance(const rs_distant *d, vec3f w);
+
 /* Whether unit direction w lies in the sun's disc. */
 int distant_in_sun(const rs_distant *d, vec3f w);
 

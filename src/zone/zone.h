@@ -12,6 +12,7 @@
 #include "light/distant.h"
 #include "zone/light/direct.h"
 #include "zone/light/occluders.h"
+#include "zone/light/sky_portals.h"
 #include "zone/maps/surface_nodes.h"
 #include "zone/transfer/sender_tree.h"
 
@@ -128,6 +129,8 @@ typedef struct zone_forest {
     vec3f *sky_dirs, *sky_weight;
     int sky_dir_count;
     float *sky_open;    /* ZONE_SKY_TABLE_W x ZONE_SKY_TABLE_H x rgb */
+    sky_portals portals; /* the panes, where the sky's gather aims (under a
+                            sky) */
     int *glint_spheres; /* spheres that reflect lights as images (glint.h) */
     int glint_count;
     vec3 *dirs;         /* the gather directions (q.gather of them) */

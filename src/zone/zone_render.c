@@ -24,6 +24,7 @@ static void fill_forest_stats(const zone_forest *f, const zt_renderer *r, zt_ren
     stats->cuts = f->cuts;
     stats->cuts_capped = f->cuts_capped;
     stats->cuts_shared = f->cuts_shared;
+    stats->sky_portals = f->portals.count;
     stats->nodes_gathered = f->gathers;
     /* Here, not only at creation: a renderer made without stats (saving
      * its forest first) reports it with its first image. */

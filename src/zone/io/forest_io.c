@@ -628,5 +628,8 @@ uint64_t forest_memory(const zone_forest *f)
     b += (uint64_t)sn->prim_count * sizeof(node_prim);
     b += (uint64_t)f->map_levels * sn->node_count * 3 * sizeof(float);
     b += (uint64_t)f->occ.node_count * sizeof(occ_node) + (uint64_t)f->occ.prim_count * 4;
+    if (f->portals.of_prim)
+        b += (uint64_t)f->portals.count * sizeof(sky_portal) +
+             (uint64_t)f->portals.prim_count * sizeof(int32_t);
     return b;
 }

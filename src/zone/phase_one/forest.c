@@ -327,6 +327,8 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
     f->sky = !f3_is_black(rs->sky) || rs->distant.map;
     if (rs->distant.map && !sky_map_directions(f, rs))
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    if (f->sky && !sky_portals_build(&f->portals, rs))
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the sky's portals");
     if (rs->distant.sun) {
         /* The sun's disc lies beyond a ball holding the scene (direct.h). */
         int finite = lo.x <= hi.x;
@@ -354,6 +356,7 @@ void zone_forest_free(zone_forest *f)
     free(f->sky_dirs);
     free(f->sky_weight);
     free(f->sky_open);
+    sky_portals_free(&f->portals);
     sender_tree_free(&f->light_tree);
     memset(f, 0, sizeof *f);
 }

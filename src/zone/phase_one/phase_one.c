@@ -20,11 +20,13 @@
 #include "geom/accel.h"
 #include "geom/transmittance.h"
 #include "render/prim.h"
+#include "light/distant.h"
 #include "light/env_map.h"
 #include "geom/ray_offset.h"
 #include "render/share.h"
 #include "util/error.h"
 #include "util/vec3_convert.h"
+#include "zone/light/sky_portals.h"
 #include "zone/maps/mesh_rounds.h"
 #include "zone/maps/node_groups.h"
 #include "zone/maps/node_twins.h"
@@ -79,18 +81,79 @@ static void sky_share(int split, int count, int *first, int *stride)
     *stride = s;
 }
 
+/* The share of the gather's count that a point aims at portals. */
+#define SKY_PORTAL_SHARE 2
+
+/* The sky's light through the portals that a point aims at (sky_portals.h):
+ * over each, the directions whose first pane is one of its own.  A split
+ * point takes its share of them, as of the gather's. */
+static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
+                                const sky_portal_pick *picks, int count)
+{
+    const zone_forest *f = t->f;
+    const rscene *rs = &t->r->rs;
+    int total = 0, first, stride;
+    for (int i = 0; i < count; i++)
+        total += picks[i].count;
+    sky_share(t->light_split, total, &first, &stride);
+    vec3 e = v3(0, 0, 0);
+    int k = 0;
+    for (int i = 0; i < count; i++) {
+        for (int j = 0; j < picks[i].count; j++, k++) {
+            if (k % stride != first)
+                continue;
+            vec3 d;
+            double share = sky_portal_view_direction(&picks[i].view, j, picks[i].count, &d);
+            double c = v3_dot(n, d);
+            if (!(share > 0) || c <= 0)
+                continue;
+            int pane;
+            t->rays++;
+            vec3f df = v3_to_f3(d);
+            vec3f tr = accel_transmittance_panes(rs, o, df, FLT_MAX, 1, &pane);
+            if (f3_is_black(tr) || pane < 0 || f->portals.of_prim[pane] != picks[i].portal)
+                continue;
+            vec3f l = f->sky_dir_count ? distant_map_radiance(&rs->distant, df) : rs->sky;
+            e = v3_add(e, v3_scale(f3_to_v3(f3_mul(l, tr)), share * c));
+        }
+    }
+    return v3_scale(e, stride);
+}
+
+/* Whether the gather's ray along d reaches the sky, and with what: 0 when
+ * its first pane belongs to a portal that the point aims at (that light
+ * is the portal's). */
+static vec3f sky_gather_ray(zone_trace *t, vec3f o, vec3f d, const sky_portal_pick *picks,
+                            int count)
+{
+    const rscene *rs = &t->r->rs;
+    t->rays++;
+    if (!count)
+        return accel_transmittance(rs, o, d, FLT_MAX, 1);
+    int pane;
+    vec3f tr = accel_transmittance_panes(rs, o, d, FLT_MAX, 1, &pane);
+    if (pane >= 0 && sky_portal_picked(picks, count, t->f->portals.of_prim[pane]))
+        return f3_splat(0.0f);
+    return tr;
+}
+
 vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 {
     const zone_forest *f = t->f;
     const rscene *rs = &t->r->rs;
     int first, stride;
+    vec3f nf = v3_to_f3(n), o = ray_offset(v3_to_f3(x), nf);
+    sky_portal_pick picks[SKY_PORTAL_PICKS_MAX];
+    int picked = f->portals.count
+                     ? sky_portals_pick(&f->portals, x, n, f->q.gather / SKY_PORTAL_SHARE, picks)
+                     : 0;
+    vec3 portals = picked ? sky_through_portals(t, n, o, picks, picked) : v3(0, 0, 0);
     if (f->sky_dir_count) {
         /* An environment map: the open-surface irradiance of the normal,
          * times the share of it that the importance-drawn directions find
          * arriving (a ratio estimate: exact where nothing is in the way;
          * the share's whole is taken over every direction, which costs no
          * ray). */
-        vec3f nf = v3_to_f3(n), o = ray_offset(v3_to_f3(x), nf);
         vec3f seen = f3_splat(0.0f), all = f3_splat(0.0f);
         sky_share(t->light_split, f->sky_dir_count, &first, &stride);
         for (int k = 0; k < f->sky_dir_count; k++) {
@@ -100,8 +163,7 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
             all = f3_madd(all, f->sky_weight[k], c);
             if (k % stride != first)
                 continue;
-            t->rays++;
-            vec3f tr = accel_transmittance(rs, o, f->sky_dirs[k], FLT_MAX, 1);
+            vec3f tr = sky_gather_ray(t, o, f->sky_dirs[k], picks, picked);
             if (!f3_is_black(tr))
                 seen = f3_madd(seen, f3_mul(f->sky_weight[k], tr), c);
         }
@@ -109,28 +171,26 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
          * the block's points together see what one point's would. */
         seen = f3_scale(seen, (float)stride);
         vec3 open = sky_open_irradiance(f, nf);
-        return v3(all.x > 0.0f ? open.x * seen.x / all.x : open.x,
-                  all.y > 0.0f ? open.y * seen.y / all.y : open.y,
-                  all.z > 0.0f ? open.z * seen.z / all.z : open.z);
+        return v3_add(portals, v3(all.x > 0.0f ? open.x * seen.x / all.x : open.x,
+                                  all.y > 0.0f ? open.y * seen.y / all.y : open.y,
+                                  all.z > 0.0f ? open.z * seen.z / all.z : open.z));
     }
     vec3 tt, bb;
     v3_frame(n, &tt, &bb);
-    vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
     vec3f open = f3_splat(0.0f);
     sky_share(t->light_split, f->q.gather, &first, &stride);
     int taken = 0;
     for (int k = first; k < f->q.gather; k += stride) {
         const vec3 *dk = &f->dirs[k];
         vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
-        open = f3_add(open, accel_transmittance(rs, o, v3_to_f3(d), FLT_MAX, 1));
-        t->rays++;
+        open = f3_add(open, sky_gather_ray(t, o, v3_to_f3(d), picks, picked));
         taken++;
     }
     /* Each channel as sky x (pi x count / n): open holds whole counts
      * unless a pane is in the way. */
-    return v3(rs->sky.x * (3.14159265358979 * open.x / taken),
-              rs->sky.y * (3.14159265358979 * open.y / taken),
-              rs->sky.z * (3.14159265358979 * open.z / taken));
+    return v3_add(portals, v3(rs->sky.x * (3.14159265358979 * open.x / taken),
+                              rs->sky.y * (3.14159265358979 * open.y / taken),
+                              rs->sky.z * (3.14159265358979 * open.z / taken)));
 }
 
 /* Mesh vertex nodes share a cut (node_groups.h) within GROUP_RADIUS x h
