@@ -9,7 +9,9 @@
 
 /* 12: the forest of nodes (docs/zone-tracer.md): zones per surface, lobe
  * and level, and the irradiance of every node. */
-#define FOREST_FILE_VERSION 13
+/* 14: the same fields; level 0 under a sky takes window panes as portals
+ * (light/sky_portals.h), so levels made before differ. */
+#define FOREST_FILE_VERSION 14
 
 /* Writes f (the forest of renderer r) to path, through a temporary file
  * renamed into place. */

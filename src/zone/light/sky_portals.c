@@ -12,7 +12,8 @@
 #include "util/vec3_convert.h"
 
 #define PI 3.14159265358979323846
-/* Pane triangles whose normals are this close (|cos|) lie in one window. */
+/* Pane triangles whose normals are this close (|cos|) lie in one window
+ * (and so must the first triangles of the sets they join). */
 #define PARALLEL 0.98
 /* Two windows' rectangles within this share of the larger one's size (in
  * their plane and across it) are one portal: the sheets of a double
@@ -26,6 +27,8 @@
 /* Merging windows pairwise is quadratic: above this many, each stays its
  * own portal. */
 #define MERGE_MAX 4096
+/* Triangles of a window whose edges are tried as its rectangle's side. */
+#define EDGE_TRIES 16
 /* Below this solid angle a portal is sampled evenly in area. */
 #define SMALL_OMEGA 1e-6
 
@@ -73,6 +76,22 @@ static void window_add(window *w, vec3 p)
     w->wmax = fmax(w->wmax, h);
 }
 
+static void window_reset(window *w)
+{
+    w->umin = w->vmin = w->wmin = 1e300;
+    w->umax = w->vmax = w->wmax = -1e300;
+}
+
+static void window_add_triangle(window *w, const rscene *rs, int prim)
+{
+    rs_part tmp;
+    const rs_part *p = rs_prim(rs, prim, &tmp);
+    vec3 p0 = f3_to_v3(p->p0);
+    window_add(w, p0);
+    window_add(w, v3_add(p0, f3_to_v3(p->e1)));
+    window_add(w, v3_add(p0, f3_to_v3(p->e2)));
+}
+
 static double window_size(const window *w)
 {
     return fmax(w->umax - w->umin, w->vmax - w->vmin);
@@ -87,12 +106,13 @@ static vec3 window_corner(const window *w, int k)
     return v3_add(v3_add(v3_scale(w->t, u), v3_scale(w->b, v)), v3_scale(w->n, h));
 }
 
-/* Whether b fits a: b's corners lie near a's plane (within NEAR_SHARE of
- * the larger one's size) and near its rectangle in that plane.  A pane's
- * thin edges fit its face, and so do a double glazing's sheets. */
+/* Whether b fits a: b's corners lie near a's plane and near its rectangle
+ * in that plane, within NEAR_SHARE of the smaller one's size (so that
+ * merged windows do not reach ever further).  A pane's thin edges fit its
+ * face, and so do a double glazing's sheets. */
 static int window_fits(const window *a, const window *b)
 {
-    double tol = NEAR_SHARE * fmax(window_size(a), window_size(b));
+    double tol = NEAR_SHARE * fmin(window_size(a), window_size(b));
     window c = *a;
     c.umin = c.vmin = c.wmin = 1e300;
     c.umax = c.vmax = c.wmax = -1e300;
@@ -150,13 +170,16 @@ int sky_portals_build(sky_portals *sp, const rscene *rs)
     int n = 0;
     int *tri = NULL;
     pane_corner *c = NULL;
-    int *up = NULL;
+    int *up = NULL, *live = NULL;
+    vec3f *nrm = NULL;
     window *w = NULL;
     int cap = 0, ok = 0;
     for (int q = 0; q < rs->prim_count; q++) {
         rs_part tmp;
         const rs_part *p = rs_prim(rs, q, &tmp);
-        if (p->shape != SHAPE_TRIANGLE || !rs->objects[p->object].thin || p->area <= 0)
+        const rs_object *m = &rs->objects[p->object];
+        /* What accel_transmittance_panes reports as a pane. */
+        if (p->shape != SHAPE_TRIANGLE || !m->thin || p->is_light || m->is_light || p->area <= 0)
             continue;
         if (n == cap) {
             cap = cap ? 2 * cap : 256;
@@ -174,9 +197,11 @@ int sky_portals_build(sky_portals *sp, const rscene *rs)
     c = malloc((size_t)n * 3 * sizeof *c);
     up = malloc((size_t)n * sizeof *up);
     w = calloc((size_t)n, sizeof *w);
+    live = malloc((size_t)n * sizeof *live);
+    nrm = malloc((size_t)n * sizeof *nrm);
     sp->of_prim = malloc((size_t)rs->prim_count * sizeof *sp->of_prim);
     sp->prim_count = rs->prim_count;
-    if (!c || !up || !w || !sp->of_prim)
+    if (!c || !up || !w || !live || !nrm || !sp->of_prim)
         goto done;
     for (int i = 0; i < n; i++) {
         rs_part tmp;
@@ -184,49 +209,106 @@ int sky_portals_build(sky_portals *sp, const rscene *rs)
         vec3f v[3] = {p->p0, f3_add(p->p0, p->e1), f3_add(p->p0, p->e2)};
         for (int k = 0; k < 3; k++)
             c[3 * i + k] = (pane_corner){v[k].x, v[k].y, v[k].z, i};
+        nrm[i] = p->n;
         up[i] = i;
     }
+    /* Triangles that share a corner join when they are parallel, and so
+     * are the sets they belong to (their first triangles): a curved pane
+     * of small facets does not become one flat window. */
     qsort(c, (size_t)n * 3, sizeof *c, corner_cmp);
-    for (int i = 1; i < 3 * n; i++) {
-        if (c[i].x != c[i - 1].x || c[i].y != c[i - 1].y || c[i].z != c[i - 1].z)
+    for (int lo = 0, hi; lo < 3 * n; lo = hi) {
+        for (hi = lo + 1; hi < 3 * n && c[hi].x == c[lo].x && c[hi].y == c[lo].y &&
+                          c[hi].z == c[lo].z;
+             hi++)
+            ;
+        for (int i = lo; i < hi; i++)
+            for (int j = i + 1; j < hi; j++) {
+                int a = c[i].tri, b = c[j].tri, ra = find(up, a), rb = find(up, b);
+                if (ra != rb && fabsf(f3_dot(nrm[a], nrm[b])) >= PARALLEL &&
+                    fabsf(f3_dot(nrm[ra], nrm[rb])) >= PARALLEL)
+                    up[rb] = ra;
+            }
+    }
+    /* A window per set of touching triangles: its first triangle's
+     * normal, and the smallest rectangle around its corners whose side
+     * lies along one of its triangles' edges (the first EDGE_TRIES
+     * triangles'); a window's glass is a rectangle, and a rectangle on the
+     * slant of a diagonal would be twice the glass. */
+    int *order = malloc((size_t)n * sizeof *order);
+    int *start = malloc((size_t)(n + 1) * sizeof *start);
+    int *fill = malloc((size_t)n * sizeof *fill);
+    if (!order || !start || !fill) {
+        free(order);
+        free(start);
+        free(fill);
+        goto done;
+    }
+    for (int i = 0; i <= n; i++)
+        start[i] = 0;
+    for (int i = 0; i < n; i++)
+        start[find(up, i) + 1]++;
+    for (int i = 0; i < n; i++)
+        start[i + 1] += start[i];
+    for (int i = 0; i < n; i++)
+        fill[i] = start[i];
+    for (int i = 0; i < n; i++)
+        order[fill[find(up, i)]++] = i;
+    for (int r = 0; r < n; r++) {
+        int a = start[r], b = start[r + 1];
+        if (a == b)
             continue;
-        rs_part ta, tb;
-        const rs_part *a = rs_prim(rs, tri[c[i - 1].tri], &ta);
-        const rs_part *b = rs_prim(rs, tri[c[i].tri], &tb);
-        if (fabsf(f3_dot(a->n, b->n)) >= PARALLEL)
-            up[find(up, c[i].tri)] = find(up, c[i - 1].tri);
-    }
-    /* A window per set of touching triangles, in the frame of its root's
-     * normal. */
-    for (int i = 0; i < n; i++) {
-        int r = find(up, i);
-        rs_part tmp;
-        const rs_part *p = rs_prim(rs, tri[i], &tmp);
         window *wr = &w[r];
-        if (!wr->alive) {
-            rs_part tr;
-            wr->n = f3_to_v3(rs_prim(rs, tri[r], &tr)->n);
-            v3_frame(wr->n, &wr->t, &wr->b);
-            wr->umin = wr->vmin = wr->wmin = 1e300;
-            wr->umax = wr->vmax = wr->wmax = -1e300;
-            wr->alive = 1;
+        wr->n = v3_normalize(f3_to_v3(nrm[r]));
+        double best = -1;
+        vec3 best_t = v3(0, 0, 0);
+        for (int k = a; k < b && k < a + EDGE_TRIES; k++) {
+            rs_part tk;
+            const rs_part *p = rs_prim(rs, tri[order[k]], &tk);
+            vec3 e[3] = {f3_to_v3(p->e1), f3_to_v3(p->e2), f3_to_v3(f3_sub(p->e2, p->e1))};
+            for (int m = 0; m < 3; m++) {
+                vec3 t = v3_sub(e[m], v3_scale(wr->n, v3_dot(e[m], wr->n)));
+                double len = v3_length(t);
+                if (!(len > 0))
+                    continue;
+                window trial = {.n = wr->n, .t = v3_scale(t, 1 / len)};
+                trial.b = v3_cross(trial.n, trial.t);
+                window_reset(&trial);
+                for (int q = a; q < b; q++)
+                    window_add_triangle(&trial, rs, tri[order[q]]);
+                double area = (trial.umax - trial.umin) * (trial.vmax - trial.vmin);
+                if (best < 0 || area < best) {
+                    best = area;
+                    best_t = trial.t;
+                }
+            }
         }
-        vec3 p0 = f3_to_v3(p->p0);
-        vec3 v[3] = {p0, v3_add(p0, f3_to_v3(p->e1)), v3_add(p0, f3_to_v3(p->e2))};
-        for (int k = 0; k < 3; k++)
-            window_add(wr, v[k]);
-        wr->area += p->area;
+        if (best < 0)
+            v3_frame(wr->n, &best_t, &wr->b);
+        wr->t = best_t;
+        wr->b = v3_cross(wr->n, wr->t);
+        window_reset(wr);
+        for (int q = a; q < b; q++) {
+            rs_part tq;
+            window_add_triangle(wr, rs, tri[order[q]]);
+            wr->area += rs_prim(rs, tri[order[q]], &tq)->area;
+        }
+        wr->alive = 1;
     }
+    free(start);
+    free(fill);
+    free(order);
     int windows = 0;
     for (int i = 0; i < n; i++)
-        windows += w[i].alive;
+        if (w[i].alive)
+            live[windows++] = i;
     /* Windows that fit one another become one (the one fitted into leads
      * to the other's root through up[]). */
     if (windows <= MERGE_MAX) {
         for (int changed = 1; changed;) {
             changed = 0;
-            for (int i = 0; i < n; i++)
-                for (int j = i + 1; w[i].alive && j < n; j++) {
+            for (int a = 0; a < windows; a++)
+                for (int b = a + 1; b < windows && w[live[a]].alive; b++) {
+                    int i = live[a], j = live[b];
                     if (!w[j].alive)
                         continue;
                     if (window_fits(&w[i], &w[j])) {
@@ -273,11 +355,16 @@ int sky_portals_build(sky_portals *sp, const rscene *rs)
         sp->of_prim[tri[i]] = portal_of[r];
     }
     free(portal_of);
+    sky_portal *fit = realloc(sp->p, (size_t)(sp->count > 0 ? sp->count : 1) * sizeof *sp->p);
+    if (fit)
+        sp->p = fit;
     ok = 1;
 done:
     free(tri);
     free(c);
     free(up);
+    free(live);
+    free(nrm);
     free(w);
     if (!ok)
         sky_portals_free(sp);

@@ -14,8 +14,9 @@
  *
  * The sky is then split between the two estimates by the first pane a
  * direction crosses: a direction whose first pane belongs to a portal that
- * the point aims at counts in that portal's estimate only, every other
- * direction in the fixed gather.  Nothing is counted twice or dropped, and
+ * the point aims at, and that crosses that portal's rectangle, counts in
+ * that portal's estimate only, every other direction (one that enters the
+ * window's box by its side, say) in the fixed gather.  Nothing is counted twice or dropped, and
  * a portal a point does not aim at (behind it, dark behind, or too small
  * for a direction of the budget) is gathered as before. */
 #ifndef ZT_ZONE_LIGHT_SKY_PORTALS_H
@@ -84,12 +85,26 @@ int sky_portal_view_make(const sky_portal *p, vec3 x, sky_portal_view *v);
  * direction's share of the estimate (the solid angle / count). */
 double sky_portal_view_direction(const sky_portal_view *v, int j, int count, vec3 *dir);
 
-/* Whether portal g is among the picks. */
-static inline int sky_portal_picked(const sky_portal_pick *picks, int count, int g)
+/* Whether unit direction d (world) from the view's point crosses its
+ * rectangle. */
+static inline int sky_portal_view_covers(const sky_portal_view *v, vec3 d)
+{
+    double dz = v3_dot(d, v->ez);
+    if (!(dz < 0))
+        return 0;
+    double t = v->z0 / dz, x = t * v3_dot(d, v->ex), y = t * v3_dot(d, v->ey);
+    return x >= v->x0 && x <= v->x1 && y >= v->y0 && y <= v->y1;
+}
+
+/* Whether the portals' estimate takes direction d, whose first pane
+ * belongs to portal g: g is among the picks and d crosses its rectangle
+ * (what its directions are drawn over).  Every other direction is the
+ * gather's. */
+static inline int sky_portals_claim(const sky_portal_pick *picks, int count, int g, vec3 d)
 {
     for (int i = 0; i < count; i++)
         if (picks[i].portal == g)
-            return 1;
+            return sky_portal_view_covers(&picks[i].view, d);
     return 0;
 }
 

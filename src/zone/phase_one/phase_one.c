@@ -121,8 +121,8 @@ static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
 }
 
 /* Whether the gather's ray along d reaches the sky, and with what: 0 when
- * its first pane belongs to a portal that the point aims at (that light
- * is the portal's). */
+ * the portals' estimate takes d (sky_portals_claim: that light is
+ * theirs). */
 static vec3f sky_gather_ray(zone_trace *t, vec3f o, vec3f d, const sky_portal_pick *picks,
                             int count)
 {
@@ -132,7 +132,7 @@ static vec3f sky_gather_ray(zone_trace *t, vec3f o, vec3f d, const sky_portal_pi
         return accel_transmittance(rs, o, d, FLT_MAX, 1);
     int pane;
     vec3f tr = accel_transmittance_panes(rs, o, d, FLT_MAX, 1, &pane);
-    if (pane >= 0 && sky_portal_picked(picks, count, t->f->portals.of_prim[pane]))
+    if (pane >= 0 && sky_portals_claim(picks, count, t->f->portals.of_prim[pane], f3_to_v3(d)))
         return f3_splat(0.0f);
     return tr;
 }
