@@ -15,7 +15,7 @@
 /* Pane triangles whose normals are this close (|cos|) lie in one window
  * (and so must the first triangles of the sets they join). */
 #define PARALLEL 0.98
-/* Two windows' rectangles within this share of the larger one's size (in
+/* Two windows' rectangles within this share of the smaller one's size (in
  * their plane and across it) are one portal: the sheets of a double
  * glazing, the lights of a window between its bars. */
 #define NEAR_SHARE 0.1
@@ -97,13 +97,18 @@ static double window_size(const window *w)
     return fmax(w->umax - w->umin, w->vmax - w->vmin);
 }
 
+/* The point (u, v) of the window's plane frame at height h across it. */
+static vec3 window_point(const window *w, double u, double v, double h)
+{
+    return v3_add(v3_add(v3_scale(w->t, u), v3_scale(w->b, v)), v3_scale(w->n, h));
+}
+
 /* Corner k (0..7) of the window's box: its rectangle at either side of
  * its panes' spread across it. */
 static vec3 window_corner(const window *w, int k)
 {
-    double u = k & 1 ? w->umax : w->umin, v = k & 2 ? w->vmax : w->vmin;
-    double h = k & 4 ? w->wmax : k & 8 ? 0.5 * (w->wmin + w->wmax) : w->wmin;
-    return v3_add(v3_add(v3_scale(w->t, u), v3_scale(w->b, v)), v3_scale(w->n, h));
+    return window_point(w, k & 1 ? w->umax : w->umin, k & 2 ? w->vmax : w->vmin,
+                        k & 4 ? w->wmax : w->wmin);
 }
 
 /* Whether b fits a: b's corners lie near a's plane and near its rectangle
@@ -114,8 +119,7 @@ static int window_fits(const window *a, const window *b)
 {
     double tol = NEAR_SHARE * fmin(window_size(a), window_size(b));
     window c = *a;
-    c.umin = c.vmin = c.wmin = 1e300;
-    c.umax = c.vmax = c.wmax = -1e300;
+    window_reset(&c);
     for (int k = 0; k < 8; k++)
         window_add(&c, window_corner(b, k));
     return c.wmin > a->wmin - tol && c.wmax < a->wmax + tol && c.umin < a->umax + tol &&
@@ -323,7 +327,6 @@ int sky_portals_build(sky_portals *sp, const rscene *rs)
                 }
         }
     }
-    int *index = up; /* reused below: window -> portal, through the roots */
     sp->p = malloc((size_t)n * sizeof *sp->p);
     if (!sp->p)
         goto done;
@@ -336,7 +339,7 @@ int sky_portals_build(sky_portals *sp, const rscene *rs)
             continue;
         window *wi = &w[i];
         sky_portal *p = &sp->p[sp->count];
-        p->corner = window_corner(wi, 8);
+        p->corner = window_point(wi, wi->umin, wi->vmin, 0.5 * (wi->wmin + wi->wmax));
         p->eu = v3_scale(wi->t, wi->umax - wi->umin);
         p->ev = v3_scale(wi->b, wi->vmax - wi->vmin);
         p->n = wi->n;
@@ -348,10 +351,12 @@ int sky_portals_build(sky_portals *sp, const rscene *rs)
     }
     for (int q = 0; q < rs->prim_count; q++)
         sp->of_prim[q] = -1;
+    /* A triangle's portal: its window's, or that of the window its window
+     * was merged into (up[] leads there). */
     for (int i = 0; i < n; i++) {
         int r = i;
-        while (portal_of[r] < 0 && index[r] != r)
-            r = index[r];
+        while (portal_of[r] < 0 && up[r] != r)
+            r = up[r];
         sp->of_prim[tri[i]] = portal_of[r];
     }
     free(portal_of);
@@ -421,7 +426,8 @@ int sky_portal_view_make(const sky_portal *p, vec3 x, sky_portal_view *v)
     v->g23 = g2 + g3;
     v->area = p->area;
     v->omega = g0 + g1 + g2 + g3 - 2 * PI;
-    if (v->omega < SMALL_OMEGA) {
+    v->by_area = v->omega < SMALL_OMEGA;
+    if (v->by_area) {
         /* Far and small: the formula loses its digits; the rectangle's
          * area over the distance squared instead. */
         vec3 c = v3(x0 + 0.5 * lu, y0 + 0.5 * lv, z0);
@@ -441,7 +447,7 @@ double sky_portal_view_direction(const sky_portal_view *v, int j, int count, vec
     w -= floor(w);
     vec3 local;
     double share;
-    if (v->omega < SMALL_OMEGA) {
+    if (v->by_area) {
         /* Even in area, weighed by its solid angle there. */
         local = v3(v->x0 + u * (v->x1 - v->x0), v->y0 + w * (v->y1 - v->y0), v->z0);
         double r2 = v3_dot(local, local);

@@ -59,6 +59,7 @@ typedef struct sky_portal_view {
     double b0, b1, g23;
     double omega;         /* the solid angle */
     double area;
+    int by_area;          /* far and small: drawn evenly in area */
 } sky_portal_view;
 
 typedef struct sky_portal_pick {
