@@ -49,6 +49,9 @@
  * per pixel (1,024-spp reference, its noise taken out; BENCHMARKS.md). */
 #define DETAIL_GRID 8
 #define DETAIL_SPLIT 3 /* log2(DETAIL_GRID) */
+/* Faces of one mesh that turn more than acos(CREASE_COS) apart (as a
+ * mesh's sheets end: mesh_sheet.h) are apart in an edge pixel's groups. */
+#define CREASE_COS 0.707f
 /* Specular steps a signature follows.  Fixed, not the render's depth: the
  * images of levels 0..D must use the same samples as the depth-D image,
  * or they would not add up to it. */
@@ -301,12 +304,13 @@ static int grid_samples(const p2_ctx *c, int px, int py, int g, int split, uint3
     return 1;
 }
 
-/* Scratch for one edge pixel's coverage grid (about 112 KB). */
+/* Scratch for one edge pixel's coverage grid (about 160 KB). */
 typedef struct edge_grid {
     uint32_t sig[FINE_GRID * FINE_GRID], group_sig[FINE_GRID * FINE_GRID];
     hit hits[FINE_GRID * FINE_GRID];
     int group_of[FINE_GRID * FINE_GRID], group_count[FINE_GRID * FINE_GRID];
     int group_shaded[FINE_GRID * FINE_GRID];
+    vec3f group_n[FINE_GRID * FINE_GRID]; /* a mesh group's facing (else 0) */
 } edge_grid;
 
 /* Point i of an edge pixel's n x n coverage points, in [0, 1)^2: the
@@ -362,13 +366,29 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
             saw_light |= hp->is_light;
             saw_sphere |= !hp->is_light && hp->shape == SHAPE_SPHERE;
         }
+        /* A mesh's faces that turn apart by a crease are groups of their
+         * own (its signature is one): the light on either side may differ
+         * by a step (a sunlit sill above a shaded wall), and each side's
+         * coverage is then measured instead of guessed from the subset's
+         * few samples that fall on it. */
+        int mesh = e->hits[i].part >= rs->part_count;
+        vec3f ng = f3_splat(0.0f);
+        if (mesh) {
+            rs_part tmp;
+            ng = shape_normal(rs_prim(rs, e->hits[i].part, &tmp),
+                              f3_madd(org, dir, e->hits[i].t));
+            if (f3_dot(ng, dir) > 0.0f)
+                ng = f3_neg(ng);
+        }
         int k = 0;
-        while (k < groups && e->group_sig[k] != e->sig[i])
+        while (k < groups && (e->group_sig[k] != e->sig[i] ||
+                              (mesh && f3_dot(e->group_n[k], ng) < CREASE_COS)))
             k++;
         if (k == groups) {
             e->group_sig[k] = e->sig[i];
             e->group_count[k] = 0;
             e->group_shaded[k] = 0;
+            e->group_n[k] = ng;
             groups++;
         }
         e->group_of[i] = k;
