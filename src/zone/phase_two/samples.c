@@ -50,7 +50,8 @@
 #define DETAIL_GRID 8
 #define DETAIL_SPLIT 3 /* log2(DETAIL_GRID) */
 /* Faces of one mesh that turn more than acos(CREASE_COS) apart (as a
- * mesh's sheets end: mesh_sheet.h) are apart in an edge pixel's groups. */
+ * mesh's sheets end: mesh_sheet.h) meet at a crease: apart in an edge
+ * pixel's groups, and a pixel without an edge takes the detail's 8 x 8. */
 #define CREASE_COS 0.707f
 /* Specular steps a signature follows.  Fixed, not the render's depth: the
  * images of levels 0..D must use the same samples as the depth-D image,
@@ -462,14 +463,21 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
 /* Whether a pixel that sees one mesh may hold its sub-pixel detail: the
  * distances at its corners and sample spread by more than DETAIL_STEPS
  * times the pixel's width there, as where a stack of fins shows its gaps
- * (and where a surface is tilted more than about 20 degrees from the view).
+ * (and where a surface is tilted more than about 20 degrees from the view),
+ * or a crease crosses it (a corner's face turns from the sample's by more
+ * than acos(CREASE_COS)), where the light may step from one face to the
+ * other.
  * On the engine room's level 1 at 512 x 512 against a 512-spp path image:
  * 3 pixel widths 9.1% per pixel, 1 width 7.4%, half a width 4.3% (0.96%
- * over 4 x 4 blocks; without the test 12.1%), for 1.23 times the job's time. */
+ * over 4 x 4 blocks; without the test 12.1%), for 1.23 times the job's time.
+ * The creases took the whole image at depth 3 from 0.828% to 0.760% per
+ * pixel (BENCHMARKS.md). */
 #define DETAIL_STEPS 0.5f
-static int fine_detail(const p2_ctx *c, const float ct[4], const p2_sample *s, size_t n)
+static int fine_detail(const p2_ctx *c, const float ct[4], const int cp[4], const p2_sample *s,
+                       size_t n)
 {
-    if (n == 0 || s[0].part < c->r->rs.part_count)
+    const rscene *rs = &c->r->rs;
+    if (n == 0 || s[0].part < rs->part_count)
         return 0;
     float lo = s[0].t, hi = s[0].t;
     for (int k = 0; k < 4; k++) {
@@ -478,7 +486,26 @@ static int fine_detail(const p2_ctx *c, const float ct[4], const p2_sample *s, s
         lo = fminf(lo, ct[k]);
         hi = fmaxf(hi, ct[k]);
     }
-    return hi - lo > DETAIL_STEPS * c->pixel_angle * (s[0].t + c->screen_dist);
+    if (hi - lo > DETAIL_STEPS * c->pixel_angle * (s[0].t + c->screen_dist))
+        return 1;
+    /* Both faces turned toward the eye along the sample's ray (a pixel's
+     * rays are near enough parallel); a mesh's primitives are triangles,
+     * whose normal is the same at every point. */
+    rs_part tmp;
+    vec3f ns = shape_normal(rs_prim(rs, s[0].part, &tmp), f3_madd(s[0].o, s[0].d, s[0].t));
+    if (f3_dot(ns, s[0].d) > 0.0f)
+        ns = f3_neg(ns);
+    for (int k = 0; k < 4; k++) {
+        if (cp[k] == s[0].part || cp[k] < rs->part_count)
+            continue;
+        const rs_part *p = rs_prim(rs, cp[k], &tmp);
+        vec3f nk = shape_normal(p, f3_madd(s[0].o, s[0].d, ct[k]));
+        if (f3_dot(nk, s[0].d) > 0.0f)
+            nk = f3_neg(nk);
+        if (f3_dot(ns, nk) < CREASE_COS)
+            return 1;
+    }
+    return 0;
 }
 
 /* Whether sample s sees a diffuse surface that some light (switched on or
@@ -509,7 +536,7 @@ static int busy_shadow(const p2_ctx *c, const p2_sample *s)
 
 /* The samples of pixel (px, py) given its corner signatures. */
 static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners[4],
-                         const float ct[4], seen_lights *lights, p2_row *row,
+                         const float ct[4], const int cp[4], seen_lights *lights, p2_row *row,
                          edge_grid **scratch, uint64_t *rays)
 {
     int g = c->g;
@@ -544,7 +571,7 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
             return 0;
     }
     if (!edge && !marked && g < DETAIL_GRID &&
-        fine_detail(c, ct, row->samples + start, row->sample_count - start)) {
+        fine_detail(c, ct, cp, row->samples + start, row->sample_count - start)) {
         row->sample_count = start;
         if (!grid_samples(c, px, py, DETAIL_GRID, DETAIL_SPLIT, first, lights, row, rays, &edge,
                           &curved))
@@ -629,7 +656,9 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         row->light_first[x] = row->light_count;
         const float ct[4] = {row->corner_t[x], row->corner_t[x + 1], row->corner_t[w1 + x],
                              row->corner_t[w1 + x + 1]};
-        if (!pixel_samples(c, x, y, cs, ct, &lights, row, &scratch, rays) ||
+        const int cp[4] = {row->corner_part[x], row->corner_part[x + 1],
+                           row->corner_part[w1 + x], row->corner_part[w1 + x + 1]};
+        if (!pixel_samples(c, x, y, cs, ct, cp, &lights, row, &scratch, rays) ||
             !push_lights(row, &lights)) {
             free(scratch);
             return 0;
