@@ -73,7 +73,7 @@ static void sky_share(int split, int count, int *first, int *stride)
     *stride = 1;
     if (!split)
         return;
-    int levels = DIRECT_SPLIT_LEVELS(split), index = DIRECT_SPLIT_INDEX(split);
+    int levels = DIRECT_SPLIT_SKY_LEVELS(split), index = DIRECT_SPLIT_INDEX(split);
     int s = 1;
     while (levels-- > 0 && s * 4 <= count)
         s *= 4;

@@ -351,6 +351,14 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
     int saw_light = 0, saw_sphere = 0;
     const rscene *rs = &c->r->rs;
     const int cells = n * n, quasi = c->f->q.cover_quasi;
+    /* A mesh's group is shaded as a detail pixel is (its own sub-pixel
+     * detail shows no edge, as a shadow across a sunlit sill): on the 8 x 8
+     * subset, its points sharing one point's light rays.  A group may hold
+     * few of the 64, so its sky and its gathers are shared by 2 x 2 blocks
+     * only: each point takes a quarter of a point's directions, and reads
+     * the pixels' gather records as the 4 x 4 subset's points do. */
+    const int mesh_shade =
+        shade < DETAIL_GRID && (quasi || n % DETAIL_GRID == 0) ? DETAIL_GRID : shade;
     int groups = 0;
     vec3f org, dir;
     float u, v;
@@ -394,7 +402,7 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
         }
         e->group_of[i] = k;
         e->group_count[k]++;
-        if (cover_shaded(quasi, n, shade, i))
+        if (cover_shaded(quasi, n, mesh ? mesh_shade : shade, i))
             e->group_shaded[k]++;
     }
     *rim = saw_light && saw_sphere;
@@ -409,12 +417,23 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
     size_t first_sample = row->sample_count;
     for (int i = 0; i < cells; i++) {
         int k = e->group_of[i];
-        if (!cover_shaded(quasi, n, shade, i))
+        int mesh = e->hits[i].part >= rs->part_count && mesh_shade > shade;
+        if (!cover_shaded(quasi, n, mesh ? mesh_shade : shade, i))
             continue;
         cover_point(quasi, n, i, &u, &v);
         cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
         double w = (double)e->group_count[k] / ((double)e->group_shaded[k] * cells);
-        if (!push_sample(rs, row, org, dir, e->hits[i], w, 0, gather_slot(c, px, py, 0, 1)))
+        int ls = 0;
+        zone_gather_slot slot = gather_slot(c, px, py, 0, 1);
+        if (mesh) {
+            int step = n / DETAIL_GRID;
+            int sx = quasi ? i % DETAIL_GRID : i % n / step;
+            int sy = quasi ? i / DETAIL_GRID : i / n / step;
+            int place = split_index(sx, sy, DETAIL_SPLIT);
+            ls = DIRECT_SPLIT_SKY(DETAIL_SPLIT, 1, place);
+            slot = gather_slot(c, px, py, place % 4, 4);
+        }
+        if (!push_sample(rs, row, org, dir, e->hits[i], w, ls, slot))
             return 0;
     }
     /* Surfaces too small to meet the subset: the point nearest their
