@@ -517,6 +517,21 @@ static void test_shading_normals(void **state)
     }
 }
 
+/* Level 1 of scene s by the zone tracer (*z) and by the path tracer (*p,
+ * spp samples, seed). */
+static void level_one_pair(const zt_scene *s, int spp, uint64_t seed, zt_image **z,
+                           zt_image **p)
+{
+    zt_render_options o = zt_render_options_default();
+    o.method = ZT_METHOD_ZONE;
+    o.level = 1;
+    o.threads = 2;
+    *z = render(s, &o);
+    zt_render_options po = path_options(spp, seed);
+    po.level = 1;
+    *p = render(s, &po);
+}
+
 /* A crease in a smooth mesh: a ridge of two slopes 50 degrees apart, each
  * with its own normal (a model's vertices split at a crease, as the IFC
  * house's are), seen from above, each slope tilted 25 degrees from the view
@@ -548,14 +563,8 @@ static void test_crease_in_smooth_mesh(void **state)
                  "{\"mesh\": {\"file\": \"%s\", \"smooth\": true, " TEST_DIFFUSE(0.5) "}}]}",
                  offsets[i], offsets[i], path);
         zt_scene *s = test_scene_text(text, "ridge.json");
-        zt_render_options o = zt_render_options_default();
-        o.method = ZT_METHOD_ZONE;
-        o.level = 1;
-        o.threads = 2;
-        zt_image *z = render(s, &o);
-        zt_render_options po = path_options(512, 5);
-        po.level = 1;
-        zt_image *p = render(s, &po);
+        zt_image *z, *p;
+        level_one_pair(s, 512, 5, &z, &p);
         double e = block_rel_rmse(z, p, 1);
         printf("ridge %.2f: zone against path %.3f%% per pixel\n", offsets[i], 100 * e);
         assert_true(e < 0.015);
@@ -594,14 +603,8 @@ static void test_crease_in_edge_pixels(void **state)
                  "{\"mesh\": {\"file\": \"%s\", \"smooth\": true, " TEST_DIFFUSE(0.5) "}}]}",
                  lookat[i], path);
         zt_scene *s = test_scene_text(text, "coping.json");
-        zt_render_options o = zt_render_options_default();
-        o.method = ZT_METHOD_ZONE;
-        o.level = 1;
-        o.threads = 2;
-        zt_image *z = render(s, &o);
-        zt_render_options po = path_options(1024, 3);
-        po.level = 1;
-        zt_image *p = render(s, &po);
+        zt_image *z, *p;
+        level_one_pair(s, 1024, 3, &z, &p);
         double e = block_rel_rmse(z, p, 1), all = image_mean(z) / image_mean(p) - 1;
         printf("coping %.2f: zone against path %.1f%% per pixel, %+.2f%% in all\n", lookat[i],
                100 * e, 100 * all);
