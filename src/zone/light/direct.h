@@ -60,9 +60,9 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
  * too many.  On the engine room skipping it takes Phase Two from 8.4 s to
  * 6.3 s, and changes 367 pixels by at most 0.4%. */
 #define DIRECT_SPLIT(j, i) (((j) << 16) | ((i) + 1))
-/* The same, with the sky's gather shared by blocks of k levels only (k <=
- * j: more of its directions a point, where a few points of the block see
- * a surface of their own). */
+/* The same, but the sky's gather shared by blocks of k <= j levels only
+ * (each point takes more of its directions), for blocks of which only a
+ * few points may be shaded. */
 #define DIRECT_SPLIT_SKY(j, k, i) ((((k) + 1) << 20) | DIRECT_SPLIT(j, i))
 /* A split's levels j and point i (0 for split 0), and its sky's levels. */
 #define DIRECT_SPLIT_LEVELS(split) (((split) >> 16) & 0xf)

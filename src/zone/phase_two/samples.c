@@ -53,6 +53,14 @@
  * mesh's sheets end: mesh_sheet.h) meet at a crease: apart in an edge
  * pixel's groups, and a pixel without an edge takes the detail's 8 x 8. */
 #define CREASE_COS 0.707f
+/* The geometric normal of primitive p at x, turned toward where ray
+ * direction d came from. */
+static vec3f facing_normal(const rs_part *p, vec3f x, vec3f d)
+{
+    vec3f ng = shape_normal(p, x);
+    return f3_dot(ng, d) > 0.0f ? f3_neg(ng) : ng;
+}
+
 /* Specular steps a signature follows.  Fixed, not the render's depth: the
  * images of levels 0..D must use the same samples as the depth-D image,
  * or they would not add up to it. */
@@ -381,14 +389,10 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
          * coverage is then measured instead of guessed from the subset's
          * few samples that fall on it. */
         int mesh = e->hits[i].part >= rs->part_count;
-        vec3f ng = f3_splat(0.0f);
-        if (mesh) {
-            rs_part tmp;
-            ng = shape_normal(rs_prim(rs, e->hits[i].part, &tmp),
-                              f3_madd(org, dir, e->hits[i].t));
-            if (f3_dot(ng, dir) > 0.0f)
-                ng = f3_neg(ng);
-        }
+        rs_part tmp;
+        vec3f ng = mesh ? facing_normal(rs_prim(rs, e->hits[i].part, &tmp),
+                                        f3_madd(org, dir, e->hits[i].t), dir)
+                        : f3_splat(0.0f);
         int k = 0;
         while (k < groups && (e->group_sig[k] != e->sig[i] ||
                               (mesh && f3_dot(e->group_n[k], ng) < CREASE_COS)))
@@ -417,15 +421,15 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
     size_t first_sample = row->sample_count;
     for (int i = 0; i < cells; i++) {
         int k = e->group_of[i];
-        int mesh = e->hits[i].part >= rs->part_count && mesh_shade > shade;
-        if (!cover_shaded(quasi, n, mesh ? mesh_shade : shade, i))
+        int detail = e->hits[i].part >= rs->part_count && mesh_shade > shade;
+        if (!cover_shaded(quasi, n, detail ? mesh_shade : shade, i))
             continue;
         cover_point(quasi, n, i, &u, &v);
         cam_ray(&c->c, (float)px + u, (float)py + v, &org, &dir);
         double w = (double)e->group_count[k] / ((double)e->group_shaded[k] * cells);
         int ls = 0;
         zone_gather_slot slot = gather_slot(c, px, py, 0, 1);
-        if (mesh) {
+        if (detail) {
             int step = n / DETAIL_GRID;
             int sx = quasi ? i % DETAIL_GRID : i % n / step;
             int sy = quasi ? i / DETAIL_GRID : i / n / step;
@@ -511,16 +515,11 @@ static int fine_detail(const p2_ctx *c, const float ct[4], const int cp[4], cons
      * rays are near enough parallel); a mesh's primitives are triangles,
      * whose normal is the same at every point. */
     rs_part tmp;
-    vec3f ns = shape_normal(rs_prim(rs, s[0].part, &tmp), f3_madd(s[0].o, s[0].d, s[0].t));
-    if (f3_dot(ns, s[0].d) > 0.0f)
-        ns = f3_neg(ns);
+    vec3f ns = facing_normal(rs_prim(rs, s[0].part, &tmp), f3_madd(s[0].o, s[0].d, s[0].t), s[0].d);
     for (int k = 0; k < 4; k++) {
         if (cp[k] == s[0].part || cp[k] < rs->part_count)
             continue;
-        const rs_part *p = rs_prim(rs, cp[k], &tmp);
-        vec3f nk = shape_normal(p, f3_madd(s[0].o, s[0].d, ct[k]));
-        if (f3_dot(nk, s[0].d) > 0.0f)
-            nk = f3_neg(nk);
+        vec3f nk = facing_normal(rs_prim(rs, cp[k], &tmp), f3_madd(s[0].o, s[0].d, ct[k]), s[0].d);
         if (f3_dot(ns, nk) < CREASE_COS)
             return 1;
     }
@@ -544,9 +543,7 @@ static int busy_shadow(const p2_ctx *c, const p2_sample *s)
     const rs_part *p = rs_prim(rs, s->part, &tmp);
     if (p->is_light || !(rs->objects[p->object].weight[LOBE_DIFFUSE] > 0.0f))
         return 0;
-    vec3f x = f3_madd(s->o, s->d, s->t), ng = shape_normal(p, x);
-    if (f3_dot(ng, s->d) > 0.0f)
-        ng = f3_neg(ng);
+    vec3f x = f3_madd(s->o, s->d, s->t), ng = facing_normal(p, x, s->d);
     for (int i = 0; i < rs->light_count; i++)
         if (direct_by_rays(&c->f->direct, rs->lights[i].part, f3_to_v3(x), f3_to_v3(ng)))
             return 1;
