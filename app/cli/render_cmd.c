@@ -172,7 +172,8 @@ static void print_zone_stats(const zt_render_stats *s, const char *loaded_from)
                 (unsigned long long)s->cuts_shared);
     if (s->sky_portals)
         fprintf(stderr, "sky portals: %d windows of panes\n", s->sky_portals);
-    fprintf(stderr, "forest memory: %llu bytes (%.1f MiB: zones, occluder lists and maps)\n",
+    fprintf(stderr,
+            "forest memory: %llu bytes (%.1f MiB: zones, occluder lists, maps and photons)\n",
             (unsigned long long)s->memory_bytes, s->memory_bytes / 1048576.0);
     if (s->forest_loaded)
         fprintf(stderr, "phase one: read from %s in %.3f s; phase two: %.3f s\n",

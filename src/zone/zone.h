@@ -13,6 +13,7 @@
 #include "zone/light/direct.h"
 #include "zone/light/occluders.h"
 #include "zone/light/sky_portals.h"
+#include "zone/maps/photon_map.h"
 #include "zone/maps/surface_nodes.h"
 #include "zone/transfer/sender_tree.h"
 
@@ -107,6 +108,12 @@ typedef struct zone_forest {
      * lobes: the gathers' rays see all other light, and add this
      * from the sample's own nodes (gather.c).  NULL otherwise. */
     float *c;           /* [level][node][rgb] */
+    /* The caustic photons as points, and what the nodes took of them
+     * (part of e and c): a camera sample's caustic is read from the one
+     * instead of the other (photon_map.h).  Empty and NULL without
+     * caustics. */
+    photon_map photons;
+    float *caustic;     /* [level][node][rgb] */
     occluder_index occ;
     direct_ctx direct;
     sender_tree light_tree; /* the lights, when there are many */
@@ -220,6 +227,11 @@ typedef struct zone_trace {
     /* The gathers' first hits of the pixel being shaded, kept for its next
      * level's terms (the pixel strategy's; NULL: none kept). */
     struct zone_gather_memo *memo;
+    /* A camera path's eye and the angle a pixel spans there: a pixel's
+     * footprint at x is about pixel_angle |x - eye| wide (the caustics'
+     * density is read over it, zone_caustic_read); 0: no footprint. */
+    vec3f eye;
+    float pixel_angle;
 } zone_trace;
 
 /* A pixel's gathered rays' first hits: its level-2 and level-3 terms gather
@@ -247,6 +259,15 @@ vec3 zone_map_read_levels(const zone_forest *f, const rscene *rs, int first, int
  * where it is not kept apart). */
 vec3 zone_specular_map_read(const zone_forest *f, const rscene *rs, int level, int prim,
                             int side, vec3 x);
+
+/* What a camera path reads of the caustics of levels first..last at x
+ * (facing normal nf) on side `side` of prim, beyond the nodes': the
+ * photons' density there less what the nodes took of them (0 without
+ * caustics).  Added to the nodes' irradiance, the caustic is the photons'
+ * own, at their resolution or at a pixel's footprint, whichever is coarser
+ * (photon_map.h). */
+vec3 zone_caustic_read(const zone_trace *t, int first, int last, int prim, int side, vec3 x,
+                       vec3 nf);
 
 /* The radiance of an escaping ray in direction d: the sky's colour or map,
  * and the sun. */
@@ -301,9 +322,12 @@ enum {
                             it */
     ZR_CAUSTIC_LIGHT = 32, /* set by zone_radiance under ZR_NO_CAUSTIC: this
                             very ray left a caustic target */
-    ZR_WHOLE_HIT = 64    /* the surface hit by this very ray counts whole,
+    ZR_WHOLE_HIT = 64,   /* the surface hit by this very ray counts whole,
                             its coverage (alpha) being the caller's: Phase
                             Two's samples are split at it (samples.c) */
+    ZR_BLURRED = 128     /* the path passed a rough lobe: caustics it meets
+                            are read from the nodes, not the photons (the
+                            lobe blurs them more than the nodes do) */
 };
 vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count);

@@ -194,6 +194,27 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
         w_i32(&w, f->c != NULL);
         if (f->c)
             w_f32s(&w, f->c, (size_t)f->map_levels * f->sn.node_count * 3);
+        /* The caustic photons in their trees' order, and what the nodes
+         * took of them. */
+        w_i32(&w, f->caustic != NULL);
+        if (f->caustic) {
+            w_f32s(&w, f->caustic, (size_t)f->map_levels * f->sn.node_count * 3);
+            /* Levels a time limit left unbuilt are not kept: their photons
+             * are the trees' last (by level). */
+            size_t kept = 0;
+            while (kept < f->photons.count && f->photons.p[kept].level < f->map_levels)
+                kept++;
+            w_u64(&w, kept);
+            for (size_t i = 0; i < kept; i++) {
+                const zone_photon *p = &f->photons.p[i];
+                w_f32s(&w, p->x, 3);
+                w_f32s(&w, p->flux, 3);
+                w_i32(&w, p->surface);
+                w_bytes(&w, p->n, 3);
+                w_bytes(&w, &p->level, 1);
+                w_bytes(&w, &f->photons.axis[i], 1);
+            }
+        }
     }
     uint64_t size = (uint64_t)w.n + 8;
     if (!w.failed)
@@ -392,6 +413,66 @@ static zt_status check_options(const char *path, const forest_options *file,
     char full[ZT_ERROR_MESSAGE_MAX];
     snprintf(full, sizeof full, pre, path);
     return zt_fail(err, ZT_ERR_PARSE, "%s%s", full, msg);
+}
+
+/* Bytes of one photon in the file. */
+#define PHOTON_BYTES 30
+
+/* The caustic photons and the nodes' part of them, if the file has them. */
+static zt_status read_photons(zone_forest *f, const rscene *rs, rbuf *rb, const char *path,
+                              zt_error *err)
+{
+    int has = r_i32(rb);
+    if (rb->short_read || has == 0)
+        return rb->short_read ? ZT_ERR_PARSE : ZT_OK;
+    if (has != 1)
+        return corrupt(err, path, "bad caustic flag");
+    size_t n = (size_t)f->map_levels * (size_t)f->sn.node_count * 3;
+    int oom = 0;
+    f->caustic = r_f32s(rb, n, &oom);
+    uint64_t count = r_u64(rb);
+    if (oom)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+    if (rb->short_read || count > (rb->n - rb->at) / PHOTON_BYTES)
+        return ZT_ERR_PARSE;
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(f->caustic[i]))
+            return corrupt(err, path, "bad caustic values");
+    photon_map *m = &f->photons;
+    m->p = malloc(((size_t)count + 1) * sizeof *m->p);
+    m->axis = malloc((size_t)count + 1);
+    if (!m->p || !m->axis)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+    m->count = m->capacity = (size_t)count;
+    int surfaces = rs->part_count + rs->object_count;
+    for (size_t i = 0; i < m->count; i++) {
+        zone_photon *p = &m->p[i];
+        int bad = 0;
+        for (int k = 0; k < 3; k++) {
+            p->x[k] = r_f32(rb);
+            bad |= !isfinite(p->x[k]);
+        }
+        for (int k = 0; k < 3; k++) {
+            p->flux[k] = r_f32(rb);
+            bad |= !(p->flux[k] >= 0.0f && p->flux[k] < INFINITY);
+        }
+        p->surface = r_i32(rb);
+        const unsigned char *b = r_take(rb, 5);
+        if (!b)
+            return ZT_ERR_PARSE;
+        memcpy(p->n, b, 3);
+        p->level = b[3];
+        m->axis[i] = b[4];
+        if (bad || p->surface < 0 || p->surface >= surfaces || p->level < 1 ||
+            p->level >= f->map_levels)
+            return corrupt(err, path, "bad caustic photons");
+    }
+    int adopted = photon_map_adopt(m);
+    if (adopted < 0)
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
+    if (adopted == 0)
+        return corrupt(err, path, "caustic photons out of order");
+    return ZT_OK;
 }
 
 zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *expect,
@@ -608,6 +689,9 @@ zt_status forest_load(zone_forest *f, const zt_renderer *r, const zone_quality *
         memcpy(f->sn.live, live, nn);
         memcpy(f->sn.pos, pos, nn * 3 * sizeof(float));
         free(pos);
+        st = read_photons(f, &r->rs, &rb, path, err);
+        if (st != ZT_OK)
+            goto done;
     }
     if (!rb.short_read && rb.at != n - 8)
         st = corrupt(err, path, "unexpected data after the nodes");
@@ -631,5 +715,11 @@ uint64_t forest_memory(const zone_forest *f)
     if (f->portals.of_prim)
         b += (uint64_t)f->portals.count * sizeof(sky_portal) +
              (uint64_t)f->portals.prim_count * sizeof(int32_t);
+    if (f->c)
+        b += (uint64_t)f->map_levels * sn->node_count * 3 * sizeof(float);
+    if (f->caustic)
+        b += (uint64_t)f->map_levels * sn->node_count * 3 * sizeof(float) +
+             (uint64_t)f->photons.count * (sizeof(zone_photon) + 1) +
+             (uint64_t)f->photons.group_count * sizeof(photon_group);
     return b;
 }

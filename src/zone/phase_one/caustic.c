@@ -16,6 +16,7 @@
 #include "zone/phase_two/media.h"
 #include "zone/phase_one/glint.h"
 #include "zone/phase_one/specular_targets.h"
+#include "zone/maps/photon_map.h"
 
 #define PI_D 3.14159265358979323846
 #define CHUNK 1024        /* photons per work item */
@@ -37,6 +38,7 @@ typedef struct deposits {
     deposit *d;
     size_t n, cap;
     int failed;
+    photon_map photons; /* the same flux as points (photon_map.h) */
 } deposits;
 
 /* One (light, target) pair, its photon count and the light's emission
@@ -100,7 +102,7 @@ static void push(deposits *o, deposit dep)
  * specular events: shared among the nodes that interpolate x by their
  * weights (their irradiance grows by their share over their area, below).
  * Splatting onto nodes blurs a caustic by about a node spacing. */
-static void deposit_at(tracer *t, int prim, int level, int side, vec3 x, vec3 flux)
+static void deposit_at(tracer *t, int prim, int level, int side, vec3 x, vec3 nf, vec3 flux)
 {
     if (level >= t->f->map_levels)
         return;
@@ -116,6 +118,14 @@ static void deposit_at(tracer *t, int prim, int level, int side, vec3 x, vec3 fl
         push(t->out, (deposit){node[k], (unsigned char)level,
                                {(float)(flux.x * w[k]), (float)(flux.y * w[k]),
                                 (float)(flux.z * w[k])}});
+    zone_photon ph = {{(float)x.x, (float)x.y, (float)x.z},
+                      {(float)flux.x, (float)flux.y, (float)flux.z},
+                      zone_surface_of(t->rs, prim),
+                      {(int8_t)lrint(127.0 * nf.x), (int8_t)lrint(127.0 * nf.y),
+                       (int8_t)lrint(127.0 * nf.z)},
+                      (uint8_t)level};
+    if (!t->out->failed && !photon_map_add(&t->out->photons, &ph))
+        t->out->failed = 1;
 }
 
 
@@ -211,7 +221,7 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     }
     vec3 color = f3_to_v3(m->color);
     if (k >= 1 && !glint && m->weight[LOBE_DIFFUSE] > 0.0f)
-        deposit_at(t, h.part, k, back, f3_to_v3(xf), flux);
+        deposit_at(t, h.part, k, back, f3_to_v3(xf), f3_to_v3(nf), flux);
     double cmax = v3_max(color);
     if (m->thin) {
         /* A pane passes flux on undeviated and at the same count of
@@ -572,7 +582,7 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
     for (int k = 0; k < npairs; k++)
         for (int first = 0; first < pairs[k].photons; first += CHUNK) {
             int left = pairs[k].photons - first;
-            jobs[njobs++] = (job){k, first, left < CHUNK ? left : CHUNK, {NULL, 0, 0, 0}};
+            jobs[njobs++] = (job){.pair = k, .first = first, .count = left < CHUNK ? left : CHUNK};
         }
     uint64_t rays = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(render_thread_count(r->options.threads)) \
@@ -581,6 +591,13 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
         tracer t = {f, rs, targets, &jobs[k].out, 0};
         for (int i = 0; i < jobs[k].count; i++)
             shoot(&t, &pairs[jobs[k].pair], jobs[k].first + i);
+        /* Kept until every job is done: no room to spare. */
+        photon_map *ph = &jobs[k].out.photons;
+        zone_photon *fit = ph->count ? realloc(ph->p, ph->count * sizeof *fit) : NULL;
+        if (fit) {
+            ph->p = fit;
+            ph->capacity = ph->count;
+        }
         rays += t.rays;
     }
     f->rays += rays;
@@ -625,9 +642,41 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
         size_t n = (size_t)f->map_levels * f->sn.node_count * 3;
         for (size_t i = 0; i < n; i++)
             f->e[i] += (float)acc[i];
+        /* The photons as points, in job order, and what the nodes took
+         * of them: a camera sample reads the one instead of the other
+         * (zone_caustic_read). */
+        f->caustic = malloc((n + 3) * sizeof *f->caustic);
+        failed = !f->caustic;
+        for (size_t i = 0; i < n && !failed; i++)
+            f->caustic[i] = (float)acc[i];
+        for (int k = 0; k < njobs && !failed; k++) {
+            free(jobs[k].out.d); /* room for the photons' trees */
+            jobs[k].out.d = NULL;
+        }
+        if (!failed) {
+            /* photon_map_build takes a run of maps: the jobs' are apart. */
+            photon_map *parts = malloc((size_t)njobs * sizeof *parts + 1);
+            failed = !parts;
+            for (int k = 0; k < njobs && !failed; k++)
+                parts[k] = jobs[k].out.photons;
+            if (!failed) {
+                failed = !photon_map_build(&f->photons, parts, njobs, f->map_levels,
+                                           rs->part_count + rs->object_count);
+                for (int k = 0; k < njobs; k++)
+                    jobs[k].out.photons = parts[k];
+            }
+            free(parts);
+        }
+        if (!failed && f->photons.count == 0) {
+            /* None reached a diffuse surface: nothing to read apart. */
+            free(f->caustic);
+            f->caustic = NULL;
+        }
     }
-    for (int k = 0; k < njobs; k++)
+    for (int k = 0; k < njobs; k++) {
         free(jobs[k].out.d);
+        photon_map_free(&jobs[k].out.photons);
+    }
     free(acc);
     free(area);
     free(jobs);

@@ -126,6 +126,9 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                 e = v3_add(e, zone_sky_irradiance(t, x, n));
             l++;
         }
+        /* A camera path reads the caustics from the photons. */
+        if (exact_direct && !(flags & ZR_BLURRED) && l <= hi && t->f->caustic)
+            e = v3_add(e, zone_caustic_read(t, l - 1, hi - 1, h.part, back, x, f3_to_v3(nf)));
         if (exact_direct && zone_gathers(rs, h.part)) {
             for (; l <= hi; l++)
                 e = v3_add(e, zone_mesh_irradiance(t, xf, nf, n, l - 1, h.part, back));
@@ -164,9 +167,9 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         }
         /* Under ZR_NO_CAUSTIC every specular ray passes it on, and marks
          * the rays that leave a caustic target. */
-        int cflags = 0;
+        int cflags = flags & ZR_BLURRED;
         if (flags & ZR_NO_CAUSTIC)
-            cflags = ZR_NO_CAUSTIC | (specular_target_part(rs, h.part) ? ZR_CAUSTIC_LIGHT : 0);
+            cflags |= ZR_NO_CAUSTIC | (specular_target_part(rs, h.part) ? ZR_CAUSTIC_LIGHT : 0);
         if (k_refl > 0) {
             int rflags = exact_direct | cflags;
             if ((flags & ZR_NO_GLINT) && !back && media_count == 0 && glint_sphere(rs, h.part))

@@ -29,6 +29,14 @@ static void add_to_image(zt_image *sum, int x, int y, const double acc[3])
     px[2] += (float)acc[2];
 }
 
+/* A camera path's trace: the gather records, and the pixel's footprint
+ * (the caustics' photons are read over it). */
+static zone_trace p2_trace(const p2_ctx *c)
+{
+    return (zone_trace){.f = c->f, .r = c->r, .cache = c->cache, .eye = c->c.viewpoint,
+                        .pixel_angle = c->pixel_angle};
+}
+
 static int cmp_int(const void *a, const void *b)
 {
     int x = *(const int *)a, y = *(const int *)b;
@@ -92,7 +100,7 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
     volatile int failed = 0; /* set by any thread that runs out of memory */
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
-        zone_trace t = {.f = c->f, .r = c->r, .cache = c->cache};
+        zone_trace t = p2_trace(c);
         /* The gathers' hits, kept from a pixel's one level to the next:
          * the same rays (gather.c). */
         t.memo = malloc(sizeof *t.memo);
@@ -146,7 +154,7 @@ zt_status p2_render_reference(const p2_ctx *c, zt_image *sum, uint64_t *rays_out
     volatile int failed = 0; /* set by any thread that runs out of memory */
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
-        zone_trace t = {.f = c->f, .r = c->r, .cache = c->cache};
+        zone_trace t = p2_trace(c);
         p2_row row;
         memset(&row, 0, sizeof row);
 #pragma omp for schedule(dynamic, 1)
@@ -299,7 +307,7 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
         /* Small terms stay on this thread: waking the others costs more. */
 #pragma omp parallel num_threads(threads) reduction(+ : rays) if (n >= 256)
         {
-            zone_trace t = {.f = c->f, .r = c->r, .cache = c->cache};
+            zone_trace t = p2_trace(c);
             int done = 0;
 #pragma omp for schedule(dynamic, 16)
             for (int i = 0; i < n; i++) {

@@ -315,9 +315,9 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
     int camera = share > 0.0 && slot.samples > 0;
     int k_max = camera ? sample_count(q->rough_pixel, share, q->rough_sample) : 1;
     int exact_direct = flags & ZR_EXACT_DIRECT;
-    int cflags = 0;
+    int cflags = ZR_BLURRED;
     if (flags & ZR_NO_CAUSTIC)
-        cflags = ZR_NO_CAUSTIC | (specular_target_part(rs, s->part) ? ZR_CAUSTIC_LIGHT : 0);
+        cflags |= ZR_NO_CAUSTIC | (specular_target_part(rs, s->part) ? ZR_CAUSTIC_LIGHT : 0);
     /* Rays from here on are not the camera sample's: what they meet takes
      * one direction each of the sample's stretch, and exact direct light
      * at their ends is a point's own (no shared split). */

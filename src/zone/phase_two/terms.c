@@ -164,6 +164,9 @@ static vec3 map_value(zone_trace *t, const p2_term *term, const p2_sample *s)
     vec3 e = zone_gathers(rs, s->part)
                  ? zone_mesh_irradiance(t, sf.xf, sf.nf, sf.n, term->level - 1, s->part, sf.back)
                  : zone_map_read(t->f, rs, term->level - 1, s->part, sf.back, sf.x);
+    if (t->f->caustic)
+        e = v3_add(e, zone_caustic_read(t, term->level - 1, term->level - 1, s->part, sf.back,
+                                        sf.x, f3_to_v3(sf.nf)));
     return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
 }
 
