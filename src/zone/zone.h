@@ -114,6 +114,10 @@ typedef struct zone_forest {
      * caustics. */
     photon_map photons;
     float *caustic;     /* [level][node][rgb] */
+    /* The sun sent photons too: rays that leave a caustic target count it
+     * no more (ZR_CAUSTIC_LIGHT), as they count no light part that sends
+     * them. */
+    int sun_photons;
     occluder_index occ;
     direct_ctx direct;
     sender_tree light_tree; /* the lights, when there are many */
@@ -260,6 +264,12 @@ vec3 zone_map_read_levels(const zone_forest *f, const rscene *rs, int first, int
 vec3 zone_specular_map_read(const zone_forest *f, const rscene *rs, int level, int prim,
                             int side, vec3 x);
 
+/* The surface a photon on prim counts for: a mesh's material, or a part;
+ * the triangle parts of one thing together (a quad's two triangles: the
+ * photons' discs must not end at the diagonal), the normals keeping its
+ * faces apart. */
+int zone_photon_surface(const rscene *rs, int prim);
+
 /* What a camera path reads of the caustics of levels first..last at x
  * (facing normal nf) on side `side` of prim, beyond the nodes': the
  * photons' density there less what the nodes took of them (0 without
@@ -318,8 +328,8 @@ enum {
     ZR_NO_CAUSTIC = 16,  /* a light reached after one or more specular events
                             and no diffuse one, the last of them off a
                             caustic target (caustic.h), counts nothing if it
-                            sends photons (a triangle or sphere): they carry
-                            it */
+                            sends photons (a triangle or sphere, the sun):
+                            they carry it */
     ZR_CAUSTIC_LIGHT = 32, /* set by zone_radiance under ZR_NO_CAUSTIC: this
                             very ray left a caustic target */
     ZR_WHOLE_HIT = 64,   /* the surface hit by this very ray counts whole,

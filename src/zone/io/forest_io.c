@@ -196,7 +196,7 @@ zt_status forest_save(const zone_forest *f, const zt_renderer *r, const char *pa
             w_f32s(&w, f->c, (size_t)f->map_levels * f->sn.node_count * 3);
         /* The caustic photons in their trees' order, and what the nodes
          * took of them. */
-        w_i32(&w, f->caustic != NULL);
+        w_i32(&w, (f->caustic != NULL) | (f->sun_photons ? 2 : 0));
         if (f->caustic) {
             w_f32s(&w, f->caustic, (size_t)f->map_levels * f->sn.node_count * 3);
             /* Levels a time limit left unbuilt are not kept: their photons
@@ -423,18 +423,23 @@ static zt_status read_photons(zone_forest *f, const rscene *rs, rbuf *rb, const 
                               zt_error *err)
 {
     int has = r_i32(rb);
-    if (rb->short_read || has == 0)
-        return rb->short_read ? ZT_ERR_PARSE : ZT_OK;
-    if (has != 1)
+    if (rb->short_read)
+        return ZT_ERR_PARSE;
+    if (has < 0 || has > 3)
         return corrupt(err, path, "bad caustic flag");
+    f->sun_photons = has >> 1;
+    if (!(has & 1))
+        return ZT_OK;
     size_t n = (size_t)f->map_levels * (size_t)f->sn.node_count * 3;
     int oom = 0;
     f->caustic = r_f32s(rb, n, &oom);
     uint64_t count = r_u64(rb);
     if (oom)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory reading the forest");
-    if (rb->short_read || count > (rb->n - rb->at) / PHOTON_BYTES)
+    if (rb->short_read)
         return ZT_ERR_PARSE;
+    if (count > (rb->n - rb->at) / PHOTON_BYTES)
+        return corrupt(err, path, "more caustic photons than the file holds");
     for (size_t i = 0; i < n; i++)
         if (!isfinite(f->caustic[i]))
             return corrupt(err, path, "bad caustic values");

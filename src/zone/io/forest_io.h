@@ -11,7 +11,7 @@
  * and level, and the irradiance of every node. */
 /* 14: the same fields; level 0 under a sky takes window panes as portals
  * (light/sky_portals.h), so levels made before differ. */
-#define FOREST_FILE_VERSION 15
+#define FOREST_FILE_VERSION 15 /* 15: the caustic photons */
 
 /* Writes f (the forest of renderer r) to path, through a temporary file
  * renamed into place. */

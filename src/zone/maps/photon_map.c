@@ -299,9 +299,10 @@ vec3 photon_map_irradiance(const photon_map *m, int level, int surface, vec3 x, 
     h.nf[2] = (float)nf.z;
     double e[3] = {0, 0, 0}, r2;
     size_t lo = g->first, hi = g->first + g->count;
-    if (r_min > 0 && r_min < r_max) {
-        /* At least k photons within the footprint: all of them over it. */
-        r2 = r_min * r_min;
+    if (r_min > 0) {
+        /* At least k photons within the footprint (or the reach, if
+         * that is smaller): all of them over it. */
+        r2 = r_min < r_max ? r_min * r_min : r_max * r_max;
         h.bound = (float)r2;
         if (sum_within(m, &h, lo, hi, e) >= PHOTON_MAP_K) {
             double k = 2.0 / (3.14159265358979323846 * r2);

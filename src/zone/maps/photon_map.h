@@ -51,10 +51,13 @@ typedef struct photon_map {
     uint8_t *axis;
 } photon_map;
 
-/* Photons the density estimate takes at a point.  With the photons of a
- * low-discrepancy set, 64 give a caustic within a few percent of its
- * converged value where it is smooth, and blur its edges over the disc of
- * 64 photons. */
+/* Photons the density estimate takes at a point at least (fewer only where
+ * fewer lie within the reach): its noise is about 1 / sqrt(k).  On a glass
+ * ball's caustic at quality 2 (tests/test_zone_caustic.c) 128, 256 and 512
+ * gave a mean error of 3.9%, 3.4% and 1.8% along a line through it, the
+ * worst point 22%, 16% and 5%; the images of materials.json and
+ * cornell_rough.json moved by less than 0.02 points, Phase Two's time on
+ * cornell_rough by 12% from 128 to 512. */
 #define PHOTON_MAP_K 512
 
 /* Appends a photon; returns 0 when out of memory. */
@@ -77,8 +80,8 @@ int photon_map_adopt(photon_map *m);
  * `level`: the PHOTON_MAP_K nearest on the same surface and side within
  * r_max, weighed by Epanechnikov's kernel over the disc that reaches the
  * k-th (or the disc of radius r_max, when fewer lie within it); where
- * they lie closer than r_min, every photon within r_min over that disc
- * (a pixel's footprint: what the image can show). */
+ * they lie closer than r_min (or r_max, if smaller), every photon within
+ * it over that disc (a pixel's footprint: what the image can show). */
 vec3 photon_map_irradiance(const photon_map *m, int level, int surface, vec3 x, vec3 nf,
                            double r_min, double r_max);
 

@@ -7,6 +7,7 @@
 #include "geom/accel.h"
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
+#include "light/distant.h"
 #include "light/light_sample.h"
 #include "material/bsdf.h"
 #include "render/prim.h"
@@ -62,6 +63,7 @@ typedef struct tracer {
     const specular_target *targets;
     deposits *out;
     uint64_t rays;
+    int sun;    /* the sun's photons: glint.c takes lights' images only */
 } tracer;
 
 static double radical_inverse(uint32_t i, uint32_t base)
@@ -120,7 +122,7 @@ static void deposit_at(tracer *t, int prim, int level, int side, vec3 x, vec3 nf
                                 (float)(flux.z * w[k])}});
     zone_photon ph = {{(float)x.x, (float)x.y, (float)x.z},
                       {(float)flux.x, (float)flux.y, (float)flux.z},
-                      zone_surface_of(t->rs, prim),
+                      zone_photon_surface(t->rs, prim),
                       {(int8_t)lrint(127.0 * nf.x), (int8_t)lrint(127.0 * nf.y),
                        (int8_t)lrint(127.0 * nf.z)},
                       (uint8_t)level};
@@ -182,10 +184,29 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     const rscene *rs = t->rs;
     hit h = accel_intersect(rs, o, d);
     t->rays++;
-    if (h.part < 0 || (first && !specular_target_hit(rs, first, h.part)))
+    if (h.part < 0)
         return;
     rs_part tmp;
     const rs_part *p = rs_prim(rs, h.part, &tmp);
+    if (first && !specular_target_hit(rs, first, h.part)) {
+        /* A pane before the target (a window in front of a glass vase) is
+         * crossed, as direct light crosses it; anything else hides the
+         * target. */
+        const rs_object *pm = &rs->objects[p->object];
+        if (!pm->thin || p->is_light)
+            return;
+        vec3f xp = shape_hit_point(p, o, d, h.t), np = shape_normal(p, xp);
+        if (f3_dot(np, d) > 0.0f)
+            np = f3_neg(np);
+        vec3 pass = v3_scale(f3_to_v3(pm->tint),
+                             pm->weight[LOBE_REFRACTIVE] *
+                                 (1.0 - bsdf_pane_reflectance(-f3_dot(np, d), pm->ior)));
+        double sp = share * v3_max(pass);
+        if (sp >= BRANCH_MIN)
+            follow(t, ray_offset(xp, f3_neg(np)), d, v3_mul(flux, pass), sp, k, glint, first,
+                   media, media_count);
+        return;
+    }
     if (p->is_light)
         return;
     const rs_object *m = &rs->objects[p->object];
@@ -264,7 +285,7 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
         k_tran = wt * (1.0 - fr);
     }
     if (k_refl > 0 && share * k_refl * cmax >= BRANCH_MIN) {
-        int g = k == 0 && !back && media_count == 0 && glint_sphere(rs, h.part);
+        int g = k == 0 && !back && media_count == 0 && !t->sun && glint_sphere(rs, h.part);
         follow(t, ray_offset(xf, nf), refl, v3_scale(v3_mul(flux, color), k_refl),
                share * k_refl * cmax, k + 1, g, NULL, media, media_count);
     }
@@ -291,8 +312,40 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
  * as moire (errors of 6% at 2^19 photons where 2^18 gave 2%).  Flux =
  * radiance x cos at the light x light area x (cone solid angle, or a
  * triangle's area-to-solid-angle factor) / n. */
+/* Photon i of n from the sun toward a target: a direction within the sun's
+ * disc (bases 2, 3) and a point of the target's cross-section, a disc of
+ * its bounding sphere's radius across the sun's axis (bases 5, 7), the ray
+ * starting beyond every finite primitive.  Flux = radiance x cos to the
+ * axis x the disc's area x the sun's solid angle / n. */
+static void shoot_sun(tracer *t, const pair *pr, int i)
+{
+    const rs_distant *sd = &t->rs->distant;
+    const specular_target *tg = &t->targets[pr->target];
+    uint32_t h = (uint32_t)i + 1;
+    const float u[2] = {(float)radical_inverse(h, 2), (float)radical_inverse(h, 3)};
+    double u3 = radical_inverse(h, 5), u4 = radical_inverse(h, 7);
+    vec3 w = f3_to_v3(distant_sun_direction(sd, u)), axis = f3_to_v3(sd->sun_dir);
+    double rho = tg->r * sqrt(u3), phi = 2.0 * PI_D * u4;
+    vec3 p = v3_add(tg->c, v3_add(v3_scale(f3_to_v3(sd->sun_t), rho * cos(phi)),
+                                  v3_scale(f3_to_v3(sd->sun_b), rho * sin(phi))));
+    const direct_ctx *dc = &t->f->direct;
+    double back = v3_length(v3_sub(p, dc->far_centre)) + dc->far_radius + tg->r + 1.0;
+    double cos_axis = v3_dot(w, axis);
+    if (!(cos_axis > 0))
+        return;
+    double scale = cos_axis * PI_D * tg->r * tg->r * 2.0 * PI_D * sd->sun_one_minus_cos /
+                   pr->photons;
+    vec3 flux = v3_scale(pr->emission, scale);
+    follow(t, v3_to_f3(v3_add(p, v3_scale(w, back))), v3_to_f3(v3_scale(w, -1.0)), flux, 1.0,
+           0, 0, tg, NULL, 0);
+}
+
 static void shoot(tracer *t, const pair *pr, int i)
 {
+    if (pr->light == DIRECT_SUN) {
+        shoot_sun(t, pr, i);
+        return;
+    }
     const rscene *rs = t->rs;
     const specular_target *tg = &t->targets[pr->target];
     rs_part ltmp;
@@ -406,7 +459,7 @@ static double target_catch(const rscene *rs, const specular_target *tg)
 static int make_pairs(const zone_forest *f, const rscene *rs, const specular_target *tg, int targets,
                       pair **out)
 {
-    int lights = 0;
+    int lights = rs->distant.sun ? 1 : 0;
     for (int j = 0; j < rs->light_count; j++) {
         rs_part tmp;
         lights += sends_photons(rs, rs->lights[j].part, rs_prim(rs, rs->lights[j].part, &tmp));
@@ -422,16 +475,22 @@ static int make_pairs(const zone_forest *f, const rscene *rs, const specular_tar
         free(imp);
         return -1;
     }
-    for (int j = 0; j < rs->light_count; j++) {
-        int li = rs->lights[j].part;
+    /* The lights, then the sun (a light number of its own). */
+    for (int j = 0; j <= rs->light_count; j++) {
+        int sun = j == rs->light_count;
+        if (sun && !rs->distant.sun)
+            break;
+        int li = sun ? DIRECT_SUN : rs->lights[j].part;
         rs_part tmp;
-        const rs_part *lp = rs_prim(rs, li, &tmp);
-        if (!sends_photons(rs, li, lp))
+        const rs_part *lp = sun ? NULL : rs_prim(rs, li, &tmp);
+        if (!sun && !sends_photons(rs, li, lp))
             continue;
-        vec3 em = f3_to_v3(rs_emission_mean(rs, li, &rs->objects[lp->object]));
-        vec3 cl;
-        double rl, total = 0;
-        part_bounding_sphere(lp, &cl, &rl);
+        vec3 em = sun ? f3_to_v3(rs->distant.sun_radiance)
+                      : f3_to_v3(rs_emission_mean(rs, li, &rs->objects[lp->object]));
+        vec3 cl = v3(0, 0, 0);
+        double rl = 0, total = 0;
+        if (!sun)
+            part_bounding_sphere(lp, &cl, &rl);
         for (int i = 0; i < targets; i++) {
             imp[i] = 0;
             if (tg[i].part == li)
@@ -439,8 +498,12 @@ static int make_pairs(const zone_forest *f, const rscene *rs, const specular_tar
             double c = target_catch(rs, &tg[i]);
             if (c <= 0)
                 continue;
+            /* What the target catches of the light: the solid angle it
+             * fills seen from the light, or its cross-section in the sun. */
             double dist = v3_length(v3_sub(tg[i].c, cl));
-            double omega = dist <= tg[i].r + rl ? 2.0 * PI_D : 2.0 * PI_D * specular_cone_omc(tg[i].r, dist);
+            double omega = sun ? PI_D * tg[i].r * tg[i].r
+                           : dist <= tg[i].r + rl ? 2.0 * PI_D
+                                                  : 2.0 * PI_D * specular_cone_omc(tg[i].r, dist);
             imp[i] = omega * c;
             total += imp[i];
         }
@@ -578,6 +641,8 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
         free(area);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for caustics");
     }
+    for (int k = 0; k < npairs; k++)
+        f->sun_photons |= pairs[k].light == DIRECT_SUN;
     njobs = 0;
     for (int k = 0; k < npairs; k++)
         for (int first = 0; first < pairs[k].photons; first += CHUNK) {
@@ -588,7 +653,7 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
 #pragma omp parallel for schedule(dynamic, 1) num_threads(render_thread_count(r->options.threads)) \
     reduction(+ : rays)
     for (int k = 0; k < njobs; k++) {
-        tracer t = {f, rs, targets, &jobs[k].out, 0};
+        tracer t = {f, rs, targets, &jobs[k].out, 0, pairs[jobs[k].pair].light == DIRECT_SUN};
         for (int i = 0; i < jobs[k].count; i++)
             shoot(&t, &pairs[jobs[k].pair], jobs[k].first + i);
         /* Kept until every job is done: no room to spare. */

@@ -28,6 +28,13 @@ int zone_surface_of(const rscene *rs, int prim)
     return rs->part_count + rs_mesh_object(mm, prim);
 }
 
+int zone_photon_surface(const rscene *rs, int prim)
+{
+    if (prim < rs->part_count && rs->parts[prim].shape == SHAPE_TRIANGLE)
+        return rs->part_count + rs->parts[prim].object;
+    return zone_surface_of(rs, prim);
+}
+
 static void box_add(vec3 *lo, vec3 *hi, vec3 q)
 {
     *lo = v3_min3(*lo, q);
@@ -437,7 +444,7 @@ vec3 zone_caustic_read(const zone_trace *t, int first, int last, int prim, int s
         first = 1;
     if (last >= f->map_levels)
         last = f->map_levels - 1;
-    int surface = zone_surface_of(rs, prim);
+    int surface = zone_photon_surface(rs, prim);
     double footprint =
         CAUSTIC_FOOTPRINT * t->pixel_angle * v3_length(v3_sub(x, f3_to_v3(t->eye)));
     for (int level = first; level <= last; level++) {

@@ -16,6 +16,7 @@
 #include "geom/accel.h"
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
+#include "light/distant.h"
 #include "light/light_sample.h"
 #include "light/mis.h"
 #include "material/bsdf.h"
@@ -28,9 +29,20 @@
 
 
 /* An escaping ray's radiance; light from far away weighed against a rough
- * lobe's light samples when mis (the lobe's density) is set. */
-static vec3 background(const rscene *rs, vec3f d, float mis)
+ * lobe's light samples when mis (the lobe's density) is set; without the
+ * sun when no_sun (its photons carry it). */
+static vec3 background(const rscene *rs, vec3f d, float mis, int no_sun)
 {
+    if (no_sun && distant_in_sun(&rs->distant, d)) {
+        vec3f l = f3_sub(zone_background(rs, d), rs->distant.sun_radiance);
+        if (mis > 0.0f) {
+            float pdf;
+            vec3f all = distant_eval(&rs->distant, d, &pdf);
+            l = f3_add(rs->sky, f3_scale(f3_sub(all, rs->distant.sun_radiance),
+                                         power_heuristic(mis, pdf)));
+        }
+        return f3_to_v3(l);
+    }
     if (!rs->distant.any || !(mis > 0.0f))
         return f3_to_v3(zone_background(rs, d));
     float pdf;
@@ -61,7 +73,9 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         t->rays++;
     }
     if (h.part < 0)
-        return lo <= 0 ? background(rs, d, mis) : v3(0, 0, 0);
+        return lo <= 0 ? background(rs, d, mis,
+                                    (flags & ZR_CAUSTIC_LIGHT) && t->f->sun_photons)
+                       : v3(0, 0, 0);
     rs_part tmp;
     const rs_part *p = rs_prim(rs, h.part, &tmp);
     vec3f xf = shape_hit_point(p, o, d, h.t);

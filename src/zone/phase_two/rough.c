@@ -138,7 +138,8 @@ static float lobes_eval(const zone_rough_at *s, const shading_frame *fr, unsigne
 }
 
 /* Level 0 by light samples: the lights (not under ZR_NO_CAUSTIC: photons
- * carry their light by specular surfaces there) and light from far away. */
+ * carry their light by specular surfaces there) and light from far away
+ * (the sun's not either at a caustic target, when it sends photons). */
 static vec3 light_samples(zone_trace *t, const zone_rough_at *s, const shading_frame *fr,
                           unsigned lobes, float weight_sum, const point_numbers *pn, int flags)
 {
@@ -167,8 +168,13 @@ static vec3 light_samples(zone_trace *t, const zone_rough_at *s, const shading_f
     vec3f wi, li;
     float far_pdf;
     float u_pick = rs->distant.map && rs->distant.sun ? pn->far : 0.0f;
-    if (rs->distant.any && distant_sample(&rs->distant, u_pick, u2, &wi, &far_pdf, &li) &&
-        !f3_is_black(li)) {
+    int got = rs->distant.any && distant_sample(&rs->distant, u_pick, u2, &wi, &far_pdf, &li);
+    if (got && (flags & ZR_NO_CAUSTIC) && t->f->sun_photons &&
+        specular_target_part(rs, s->part) && distant_in_sun(&rs->distant, wi)) {
+        li = f3_sub(li, rs->distant.sun_radiance);
+        li = f3(f_max0(li.x), f_max0(li.y), f_max0(li.z));
+    }
+    if (got && !f3_is_black(li)) {
         float pdf, f = lobes_eval(s, fr, lobes, weight_sum, wi, &pdf);
         if (f > 0.0f) {
             int below = f3_dot(s->ng, wi) < 0.0f;
