@@ -211,21 +211,24 @@ static void heap_offer(nearest *h, const zone_photon *p, float d2)
         h->bound = h->d2[0];
 }
 
+/* Whether photon p lies within the searched disc, on the same side
+ * (normals within 60 degrees); *d2 its squared distance. */
+static int within(const nearest *h, const zone_photon *p, float *d2)
+{
+    float dx = h->x[0] - p->x[0], dy = h->x[1] - p->x[1], dz = h->x[2] - p->x[2];
+    *d2 = dx * dx + dy * dy + dz * dz;
+    return *d2 < h->bound && h->nf[0] * p->n[0] + h->nf[1] * p->n[1] + h->nf[2] * p->n[2] > 63.5f;
+}
+
 static void search(const photon_map *m, nearest *h, size_t lo, size_t hi)
 {
     while (hi > lo) {
         size_t mid = lo + (hi - lo) / 2;
         const zone_photon *p = &m->p[mid];
-        float dx = h->x[0] - p->x[0], dy = h->x[1] - p->x[1], dz = h->x[2] - p->x[2];
-        float d2 = dx * dx + dy * dy + dz * dz;
-        /* The same side: normals within 60 degrees. */
-        if (d2 < h->bound &&
-            h->nf[0] * p->n[0] + h->nf[1] * p->n[1] + h->nf[2] * p->n[2] > 63.5f) {
-            if (h->n == PHOTON_MAP_K && d2 >= h->d2[0])
-                ;
-            else
-                heap_offer(h, p, d2);
-        }
+        float d2;
+        /* Once k are held the bound is the k-th's: nearer ones replace it. */
+        if (within(h, p, &d2))
+            heap_offer(h, p, d2);
         if (hi - lo == 1)
             return;
         int ax = m->axis[mid];
@@ -249,10 +252,8 @@ static size_t sum_within(const photon_map *m, const nearest *h, size_t lo, size_
     while (hi > lo) {
         size_t mid = lo + (hi - lo) / 2;
         const zone_photon *p = &m->p[mid];
-        float dx = h->x[0] - p->x[0], dy = h->x[1] - p->x[1], dz = h->x[2] - p->x[2];
-        float d2 = dx * dx + dy * dy + dz * dz;
-        if (d2 < h->bound &&
-            h->nf[0] * p->n[0] + h->nf[1] * p->n[1] + h->nf[2] * p->n[2] > 63.5f) {
+        float d2;
+        if (within(h, p, &d2)) {
             double w = 1.0 - d2 / h->bound;
             for (int c = 0; c < 3; c++)
                 e[c] += w * p->flux[c];

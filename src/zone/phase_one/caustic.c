@@ -303,15 +303,6 @@ static void follow(tracer *t, vec3f o, vec3f d, vec3 flux, double share, int k,
     }
 }
 
-/* Photon i of n of a pair: a point on the light (a triangle uniformly; a
- * sphere over the cap that can see the target) and a direction towards the
- * target (uniform in a sphere's cone, or to a uniform point of a
- * triangle), from the 4-d Halton set (bases 2, 3 for the direction, what
- * shapes a caustic; 5, 7 for the point).  Not Hammersley: its (i/n, base
- * 2) pair is a near-regular grid, which the lens maps onto the fine cells
- * as moire (errors of 6% at 2^19 photons where 2^18 gave 2%).  Flux =
- * radiance x cos at the light x light area x (cone solid angle, or a
- * triangle's area-to-solid-angle factor) / n. */
 /* Photon i of n from the sun toward a target: a direction within the sun's
  * disc (bases 2, 3) and a point of the target's cross-section, a disc of
  * its bounding sphere's radius across the sun's axis (bases 5, 7), the ray
@@ -340,6 +331,15 @@ static void shoot_sun(tracer *t, const pair *pr, int i)
            0, 0, tg, NULL, 0);
 }
 
+/* Photon i of n of a pair (the sun's: shoot_sun): a point on the light (a triangle uniformly; a
+ * sphere over the cap that can see the target) and a direction towards the
+ * target (uniform in a sphere's cone, or to a uniform point of a
+ * triangle), from the 4-d Halton set (bases 2, 3 for the direction, what
+ * shapes a caustic; 5, 7 for the point).  Not Hammersley: its (i/n, base
+ * 2) pair is a near-regular grid, which the lens maps onto the fine cells
+ * as moire (errors of 6% at 2^19 photons where 2^18 gave 2%).  Flux =
+ * radiance x cos at the light x light area x (cone solid angle, or a
+ * triangle's area-to-solid-angle factor) / n. */
 static void shoot(tracer *t, const pair *pr, int i)
 {
     if (pr->light == DIRECT_SUN) {

@@ -33,20 +33,12 @@
  * sun when no_sun (its photons carry it). */
 static vec3 background(const rscene *rs, vec3f d, float mis, int no_sun)
 {
-    if (no_sun && distant_in_sun(&rs->distant, d)) {
-        vec3f l = f3_sub(zone_background(rs, d), rs->distant.sun_radiance);
-        if (mis > 0.0f) {
-            float pdf;
-            vec3f all = distant_eval(&rs->distant, d, &pdf);
-            l = f3_add(rs->sky, f3_scale(f3_sub(all, rs->distant.sun_radiance),
-                                         power_heuristic(mis, pdf)));
-        }
-        return f3_to_v3(l);
-    }
+    vec3f sun = no_sun && distant_in_sun(&rs->distant, d) ? rs->distant.sun_radiance
+                                                          : f3_splat(0.0f);
     if (!rs->distant.any || !(mis > 0.0f))
-        return f3_to_v3(zone_background(rs, d));
+        return f3_to_v3(f3_sub(zone_background(rs, d), sun));
     float pdf;
-    vec3f l = distant_eval(&rs->distant, d, &pdf);
+    vec3f l = f3_sub(distant_eval(&rs->distant, d, &pdf), sun);
     return f3_to_v3(f3_add(rs->sky, f3_scale(l, power_heuristic(mis, pdf))));
 }
 
