@@ -306,6 +306,51 @@ static void test_caustic_deterministic(void **state)
     zt_scene_release(s);
 }
 
+/* Renders scene text at quality 0 under memory limit `limit` (0: the
+ * machine's); returns the status, with the estimate and the message. */
+static zt_status render_within(const char *text, uint64_t limit, uint64_t *estimate,
+                               zt_error *err)
+{
+    zt_scene *s = test_scene_text(text, "caustic_memory.json");
+    zt_render_options o = zt_render_options_default();
+    o.method = ZT_METHOD_ZONE;
+    o.depth = 3;
+    o.quality = 0;
+    o.threads = 2;
+    o.max_memory = limit;
+    zt_image *img = NULL;
+    zt_render_stats st = {0};
+    zt_status got = zt_render(s, &o, &img, &st, err);
+    if (estimate)
+        *estimate = st.memory_estimate;
+    assert_true(got == ZT_OK ? img != NULL : img == NULL);
+    zt_image_release(img);
+    zt_scene_release(s);
+    return got;
+}
+
+/* The photons are in the memory estimate made before the work, and the
+ * limit holds at it: one byte less is refused before they are traced.
+ * Under the sun the ball splits more photons onto the floor than were
+ * traced, past the estimate: the render stops with the limit at the
+ * estimate, as they are traced, and goes through with room for them. */
+static void test_caustic_memory(void **state)
+{
+    (void)state;
+    zt_error err = {0};
+    uint64_t e = 0, again = 0;
+    assert_int_equal(render_within(scene_text, 0, &e, &err), ZT_OK);
+    assert_int_equal(render_within(scene_text, e, &again, &err), ZT_OK);
+    assert_true(again == e);
+    assert_int_equal(render_within(scene_text, e - 1, NULL, &err), ZT_ERR_MEMORY);
+    assert_non_null(strstr(err.message, "caustic photons (131072 traced at quality 0)"));
+
+    assert_int_equal(render_within(sun_text, 0, &e, &err), ZT_OK);
+    assert_int_equal(render_within(sun_text, e, NULL, &err), ZT_ERR_MEMORY);
+    assert_non_null(strstr(err.message, "caustic photons at quality 0 outgrew"));
+    assert_int_equal(render_within(sun_text, 2 * e, NULL, &err), ZT_OK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -314,6 +359,7 @@ int main(void)
         cmocka_unit_test(test_sun_caustic),
         cmocka_unit_test(test_caustic_across_triangles),
         cmocka_unit_test(test_caustic_deterministic),
+        cmocka_unit_test(test_caustic_memory),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

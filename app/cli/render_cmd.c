@@ -94,7 +94,8 @@ static void render_usage(FILE *f)
 "Exit status: 0 done (also when a time limit cut it short), 1 bad arguments,\n"
 "2 unreadable input, 3 invalid input (scene, model, forest or checkpoint\n"
 "file), 4 unwritable output, 5 needs more memory than allowed (refused before\n"
-"the work), 6 not supported by this build, 7 other failure (or interrupted\n"
+"the work, or when the zone tracer's caustic photons outgrow their estimate),\n"
+"6 not supported by this build, 7 other failure (or interrupted\n"
 "before any image), 8 interrupted: the image so far was written, 130 or 143\n"
 "interrupted twice (SIGINT, SIGTERM): nothing written.\n");
 }

@@ -118,6 +118,8 @@ typedef struct zone_forest {
      * no more (ZR_CAUSTIC_LIGHT), as they count no light part that sends
      * them. */
     int sun_photons;
+    uint64_t photon_estimate; /* bytes the caustic photons were estimated
+                                 to take at their peak (caustic.c) */
     occluder_index occ;
     direct_ctx direct;
     sender_tree light_tree; /* the lights, when there are many */

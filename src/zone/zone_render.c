@@ -28,7 +28,9 @@ static void fill_forest_stats(const zone_forest *f, const zt_renderer *r, zt_ren
     stats->nodes_gathered = f->gathers;
     /* Here, not only at creation: a renderer made without stats (saving
      * its forest first) reports it with its first image. */
-    stats->memory_estimate = r->memory_estimate + memory_zone_nodes(f->sn.node_count, f->map_levels);
+    stats->memory_estimate = r->memory_estimate +
+                             memory_zone_nodes(f->sn.node_count, f->map_levels) +
+                             f->photon_estimate;
 }
 
 zt_status zone_prepare(zt_renderer *r, zt_render_stats *stats, zt_error *err)
