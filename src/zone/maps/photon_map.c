@@ -179,36 +179,45 @@ typedef struct nearest {
     float nf[3];
 } nearest;
 
+/* Moves entry i of the full heap down to its place. */
+static void sift_down(nearest *h, int i)
+{
+    float d2 = h->d2[i];
+    const zone_photon *p = h->p[i];
+    for (;;) {
+        int c = 2 * i + 1;
+        if (c >= PHOTON_MAP_K)
+            break;
+        if (c + 1 < PHOTON_MAP_K && h->d2[c + 1] > h->d2[c])
+            c++;
+        if (h->d2[c] <= d2)
+            break;
+        h->d2[i] = h->d2[c];
+        h->p[i] = h->p[c];
+        i = c;
+    }
+    h->d2[i] = d2;
+    h->p[i] = p;
+}
+
+/* The first k are only kept (where photons are sparse, fewer than k lie
+ * within the reach and no order is needed), and made a heap when the k-th
+ * comes; from then on a nearer one replaces the farthest. */
 static void heap_offer(nearest *h, const zone_photon *p, float d2)
 {
     if (h->n < PHOTON_MAP_K) {
-        int i = h->n++;
-        while (i > 0 && h->d2[(i - 1) / 2] < d2) {
-            h->d2[i] = h->d2[(i - 1) / 2];
-            h->p[i] = h->p[(i - 1) / 2];
-            i = (i - 1) / 2;
-        }
-        h->d2[i] = d2;
-        h->p[i] = p;
+        h->d2[h->n] = d2;
+        h->p[h->n++] = p;
+        if (h->n < PHOTON_MAP_K)
+            return;
+        for (int i = PHOTON_MAP_K / 2 - 1; i >= 0; i--)
+            sift_down(h, i);
     } else {
-        int i = 0;
-        for (;;) {
-            int c = 2 * i + 1;
-            if (c >= PHOTON_MAP_K)
-                break;
-            if (c + 1 < PHOTON_MAP_K && h->d2[c + 1] > h->d2[c])
-                c++;
-            if (h->d2[c] <= d2)
-                break;
-            h->d2[i] = h->d2[c];
-            h->p[i] = h->p[c];
-            i = c;
-        }
-        h->d2[i] = d2;
-        h->p[i] = p;
+        h->d2[0] = d2;
+        h->p[0] = p;
+        sift_down(h, 0);
     }
-    if (h->n == PHOTON_MAP_K)
-        h->bound = h->d2[0];
+    h->bound = h->d2[0];
 }
 
 /* Whether photon p lies within the searched disc, on the same side
