@@ -27,7 +27,8 @@ typedef struct bvh4_node {
  * normals and part -1: their triangle test fails on the determinant. */
 typedef struct bvh_packet {
     f4 p0[3];           /* triangle vertex 0 or sphere centre, by axis */
-    f4 e1[3], e2[3];    /* triangle edges */
+    f4 e1[3], e2[3];    /* triangle edges; a sphere's c_lo, and its r_lo
+                           in e2[0] (render_scene.h) */
     f4 n[3];            /* triangle unit normal, for t */
     f4 radius;
     i4 culled;          /* -1 culled, else 0 */

@@ -307,8 +307,13 @@ static void lane_put(f4 dst[3], int lane, vec3f v)
 static void packet_set(bvh_packet *q, int lane, const rs_part *p, int part)
 {
     lane_put(q->p0, lane, p->p0);
-    lane_put(q->e1, lane, p->e1);
-    lane_put(q->e2, lane, p->e2);
+    if (p->shape == SHAPE_SPHERE) {
+        lane_put(q->e1, lane, p->c_lo);
+        q->e2[0][lane] = p->r_lo;
+    } else {
+        lane_put(q->e1, lane, p->e1);
+        lane_put(q->e2, lane, p->e2);
+    }
     lane_put(q->n, lane, p->n);
     q->radius[lane] = p->radius;
     q->culled[lane] = p->culled ? -1 : 0;

@@ -145,6 +145,8 @@ static inline int bvh_sphere_packet(const bvh_packet *q, vec3f o, vec3f d,
         rs_part p;
         p.p0 = f3(q->p0[0][i], q->p0[1][i], q->p0[2][i]);
         p.radius = q->radius[i];
+        p.c_lo = f3(q->e1[0][i], q->e1[1][i], q->e1[2][i]); /* (bvh.h) */
+        p.r_lo = q->e2[0][i];
         p.culled = q->culled[i] != 0;
         (*t)[i] = shape_sphere_hit(&p, o, d, 0.0f, tmax);
         if ((*t)[i] > 0.0f)

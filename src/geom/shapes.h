@@ -55,6 +55,18 @@ static inline float shape_triangle_hit(const rs_part *p, vec3f o, vec3f d,
     return (t > tmin && t < tmax) ? t : -1.0f;
 }
 
+/* A sphere's centre and radius as the scene gave them, in double: a float
+ * rounds smallpt's wall centres (10^5 away) by up to 0.004, which moved
+ * its ceiling up by 0.0016 and showed 0.58% more of the light sphere that
+ * cuts through it. */
+static inline double shape_sphere_double(const rs_part *p, double c[3])
+{
+    c[0] = (double)p->p0.x + p->c_lo.x;
+    c[1] = (double)p->p0.y + p->c_lo.y;
+    c[2] = (double)p->p0.z + p->c_lo.z;
+    return (double)p->radius + p->r_lo;
+}
+
 /* Geometric form of the quadratic, which keeps precision when the ray
  * starts far away (Haines et al., Ray Tracing Gems ch. 7), in double: a
  * sphere used as a wall (radius 10^5 around a room 100 wide, as smallpt
@@ -63,10 +75,11 @@ static inline float shape_triangle_hit(const rs_part *p, vec3f o, vec3f d,
 static inline float shape_sphere_hit(const rs_part *p, vec3f o, vec3f d,
                                      float tmin, float tmax)
 {
-    double fx = (double)o.x - p->p0.x, fy = (double)o.y - p->p0.y, fz = (double)o.z - p->p0.z;
+    double ctr[3], r = shape_sphere_double(p, ctr);
+    double fx = (double)o.x - ctr[0], fy = (double)o.y - ctr[1], fz = (double)o.z - ctr[2];
     double b = -(fx * d.x + fy * d.y + fz * d.z);
     double lx = fx + d.x * b, ly = fy + d.y * b, lz = fz + d.z * b;
-    double r2 = (double)p->radius * p->radius;
+    double r2 = r * r;
     double disc = r2 - (lx * lx + ly * ly + lz * lz);
     if (disc < 0.0)
         return -1.0f;
@@ -112,14 +125,13 @@ static inline vec3f shape_hit_point(const rs_part *p, vec3f o, vec3f d, float t)
 {
     vec3f x = f3_madd(o, d, t);
     if (p->shape == SHAPE_SPHERE) {
-        double vx = (double)x.x - p->p0.x, vy = (double)x.y - p->p0.y,
-               vz = (double)x.z - p->p0.z;
+        double c[3], r = shape_sphere_double(p, c);
+        double vx = (double)x.x - c[0], vy = (double)x.y - c[1], vz = (double)x.z - c[2];
         double len = sqrt(vx * vx + vy * vy + vz * vz);
         if (!(len > 0.0))
             return x;
-        double k = p->radius / len;
-        return f3((float)(p->p0.x + vx * k), (float)(p->p0.y + vy * k),
-                  (float)(p->p0.z + vz * k));
+        double k = r / len;
+        return f3((float)(c[0] + vx * k), (float)(c[1] + vy * k), (float)(c[2] + vz * k));
     }
     if (p->shape == SHAPE_PLANE) {
         float e = f3_dot(p->n, x) - p->offset;

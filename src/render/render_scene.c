@@ -188,6 +188,8 @@ static void fill_part(rs_part *rp, const part *p, const object *o)
     }
     case SHAPE_SPHERE:
         rp->radius = (float)p->radius;
+        rp->c_lo = v3_to_f3(v3_sub(p->p[0], f3_to_v3(rp->p0)));
+        rp->r_lo = (float)(p->radius - (double)rp->radius);
         rp->area = (float)(4 * 3.14159265358979 * p->radius * p->radius);
         break;
     case SHAPE_PLANE:

@@ -27,6 +27,8 @@ typedef struct rs_part {
     vec3f tangent, bitangent; /* triangle/plane: f3_basis(n), precomputed
                                  for sampling directions around n */
     float radius;       /* sphere */
+    vec3f c_lo;         /* sphere: what p0 and radius leave out of the */
+    float r_lo;         /* scene's double values (shape_sphere_double) */
     float offset;       /* plane: n.x = offset */
     float area;         /* triangle/sphere surface area */
     float select_pdf;   /* next-event estimation's probability of choosing
