@@ -3,7 +3,7 @@
     blender -b -P tools/cycles_reference.py -- SCENE.json OUT.pfm --spp N [--seed S]
             [--size WxH] [--bounces B] [--plane-size H] [--light-offset D]
             [--sphere-subdivisions K] [--light-subdivisions K] [--scale U] [--ggx multi|single]
-            [--threads T] [--no-dielectric-specular]
+            [--threads T] [--no-dielectric-specular] [--linear-filtering]
 
 Writes OUT as linear float RGB (PFM, bottom row first, as zonetrace writes it; an OUT ending in
 .exr is written as OpenEXR instead).  Needs Blender 3.4, and numpy for its glTF importer
@@ -91,11 +91,34 @@ Supported, and nothing else (anything else stops the script with a message namin
                 leaves GGX), and with "backculled" a Transparent BSDF on the back.  "material"
                 replaces every imported material by the script's own (as for other things);
                 "smooth": false shades flat facets.
+              alphaMode MASK: the importer sets the blend method CLIP (alpha_threshold the
+                cutoff), which only EEVEE reads: Cycles would take the alpha as a fraction.
+                The Principled Alpha is made 1 - (alpha < cutoff), the cutoff clamped into
+                [0, 1] as zonetrace does: a hole below it, which every Cycles ray, shadow
+                rays too, passes untinted, as zonetrace's rays do.
+              Emission (emissiveFactor x emissiveTexture x KHR_materials_emissive_strength,
+                the one extension accepted): the importer's Principled Emission colour x
+                Emission Strength, a radiance as zonetrace's; Cycles samples the triangles
+                as mesh lights (the script says within what distance of their planes it
+                samples their solid angle, inexactly: a model's emissive triangles are not
+                cut, give it small ones).  Blender 3.4.1's importer links the float Result of
+                the Mix node that multiplies the texture by a non-grey factor (0: no light);
+                the script links the colour Result.  zonetrace's emissive triangles are
+                lights: they reflect nothing and ignore alpha, so an emissive material must
+                be OPAQUE with a black base colour and no base texture (then glTF reflects
+                only its dielectric specular layer, see --no-dielectric-specular).
+                --linear-filtering (a diagnostic) makes the imported 8-bit sRGB textures
+                without alpha linear before Cycles filters them: Cycles filters the sRGB
+                codes, zonetrace (as glTF asks) the linear values, which differ between
+                texels (halfway between white and orange 255 140 0, Cycles' blue is 0.21 of
+                white's, zonetrace's 0.5).
               Refused (with the reason): other formats, "emission" and "background" on a
-                mesh, a mirroring transform, glTF extensions, more than one scene, skins,
-                animations, morph targets, vertex colours, triangles without a material or
-                (with "smooth") without normals, alpha modes other than OPAQUE, emissive
-                materials, textures on a texCoord other than 0, NEAREST magnification or
+                mesh, a mirroring transform, glTF extensions but
+                KHR_materials_emissive_strength, more than one scene, skins, animations,
+                morph targets, vertex colours, triangles without a material or (with
+                "smooth") without normals, alphaMode BLEND (not compared yet), an emissive
+                material with alpha or a base colour, textures on a texCoord other than 0,
+                NEAREST magnification or
                 MIRRORED_REPEAT samplers, a normal texture's scale other than 1 (Blender's
                 Normal Map strength blends the unmapped and the mapped normal, glTF scales
                 x and y before normalising: they agree at 1 only), lights in the file;
@@ -131,7 +154,8 @@ where a foreground part or the camera stands behind the plane, meshes other than
 Frames: zonetrace's +y is Blender's +Z, (x, y, z) -> (x, -z, y), times --scale.  Render
 settings: Cycles on the CPU, box pixel filter 1 pixel wide, no denoising, no adaptive sampling, no
 clamping, Standard view transform, caustics on, every bounce limit --bounces (16; Cycles then
-scatters up to 17 times).
+scatters up to 17 times) but the transparent one, at least 64 (a hole or a backculled back is no
+scattering in zonetrace).
 """
 import argparse
 import array
@@ -157,6 +181,9 @@ def fail(msg):
 
 UNIT = [1.0]  # Blender units per scene unit (--scale)
 GGX_KIND = ["MULTI_GGX"]  # the rough lobes' distribution (--ggx)
+MASKED = [0]  # imported MASK materials whose alpha was made a step
+LINEARISED = [0]  # textures made linear before filtering (--linear-filtering)
+FIXED_EMISSION = [0]  # imported emissive factors relinked (fix_emissive_factor)
 
 
 def to_blender(p):
@@ -683,6 +710,7 @@ def build_object(o, ctx):
 # ---------------------------------------------------------------- model files (glTF)
 
 MESH_KEYS = {"file", "transform", "material", "backculled", "smooth"}
+GLTF_EXTENSIONS = {"KHR_materials_emissive_strength"}
 GLTF_MAX_JSON = 64 << 20
 
 
@@ -755,10 +783,12 @@ def check_gltf(doc, path, override, smooth):
         fail("%s: %s" % (path, msg))
     if not isinstance(doc, dict) or not str(doc.get("asset", {}).get("version", "")).startswith("2"):
         no("not a glTF 2 file")
-    ext = sorted(set(doc.get("extensionsUsed", [])) | set(doc.get("extensionsRequired", [])))
+    ext = sorted((set(doc.get("extensionsUsed", [])) | set(doc.get("extensionsRequired", [])))
+                 - GLTF_EXTENSIONS)
     if ext:
         no("glTF extensions are not supported by this script (%s): zonetrace reads some "
-           "(KHR_materials_ior, transmission, volume), not all as Blender does" % ", ".join(ext))
+           "(KHR_materials_ior, transmission, volume), not all as Blender does; only %s is"
+           % (", ".join(ext), ", ".join(sorted(GLTF_EXTENSIONS))))
     if len(doc.get("scenes", [])) > 1:
         no("more than one scene (zonetrace flattens every node, Blender imports one scene)")
     if doc.get("skins") or doc.get("animations"):
@@ -787,14 +817,40 @@ def check_gltf(doc, path, override, smooth):
         return
     for i, m in enumerate(doc.get("materials", [])):
         what = "material %d (%s)" % (i, m.get("name", "unnamed"))
-        if m.get("alphaMode", "OPAQUE") != "OPAQUE":
-            no("%s: alphaMode %s is not supported (zonetrace leaves coverage out)"
-               % (what, m["alphaMode"]))
-        if m.get("emissiveTexture") or any(m.get("emissiveFactor", [0, 0, 0])):
-            no("%s: an emissive material is not supported by this script" % what)
+        mode = m.get("alphaMode", "OPAQUE")
+        if mode not in ("OPAQUE", "MASK"):
+            no("%s: alphaMode %s is not supported by this script (zonetrace's BLEND is "
+               "coverage; not compared with Cycles' Principled alpha yet)" % (what, mode))
+        if mode == "MASK":
+            cutoff = m.get("alphaCutoff", 0.5)
+            if not isinstance(cutoff, (int, float)) or isinstance(cutoff, bool) or \
+                    not -1e30 < cutoff < 1e30:
+                no("%s: alphaCutoff %r is not a number zonetrace reads" % (what, cutoff))
         pbr = m.get("pbrMetallicRoughness", {})
+        exts = m.get("extensions", {})
+        for k in exts:
+            if k not in GLTF_EXTENSIONS:
+                no("%s: the material extension %s is not supported by this script" % (what, k))
+        strength = exts.get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
+        if not isinstance(strength, (int, float)) or isinstance(strength, bool) or \
+                not 0 <= strength < 1e30:
+            no("%s: emissiveStrength %r is not a number >= 0" % (what, strength))
+        if any(m.get("emissiveFactor", [0, 0, 0])) and strength > 0:
+            # zonetrace's emissive triangles are lights: they ignore alpha and reflect nothing
+            # (docs/scene-format.md), where glTF (and Blender's Principled BSDF) adds the
+            # emission to the surface's reflection.  They agree when nothing is reflected but
+            # the dielectric specular layer (--no-dielectric-specular takes it off).
+            if mode != "OPAQUE":
+                no("%s: an emissive material with alphaMode %s (zonetrace's lights ignore "
+                   "alpha, Blender's does not)" % (what, mode))
+            base = pbr.get("baseColorFactor", [1, 1, 1, 1])
+            if any(base[:3]) or pbr.get("baseColorTexture"):
+                no("%s: an emissive material whose base colour is not black (zonetrace's "
+                   "emissive triangles are lights, which reflect nothing; glTF's reflect "
+                   "their base colour too): give it baseColorFactor 0 0 0 and no base "
+                   "texture" % what)
         infos = [pbr.get("baseColorTexture"), pbr.get("metallicRoughnessTexture"),
-                 m.get("normalTexture")]
+                 m.get("normalTexture"), m.get("emissiveTexture")]
         for info in infos:
             if info and info.get("texCoord", 0) != 0:
                 no("%s: a texture on texCoord %d (only TEXCOORD_0 is supported)"
@@ -840,6 +896,89 @@ def backface_transparent(mat):
     nt.links.new(mix.outputs["Shader"], out.inputs["Surface"])
 
 
+def linear_textures(mat):
+    """--linear-filtering: each 8-bit sRGB texture without alpha of an imported material
+    replaced by a float image of its texels made linear (the sRGB curve), which Cycles then
+    filters as it is.  Cycles filters an 8-bit sRGB texture's codes and makes the result
+    linear; zonetrace makes the texels linear and filters them (as glTF asks): between a white
+    and an orange (255 140 0) texel, halfway, Cycles' blue is 0.21 of white's, zonetrace's
+    0.5.  Textures with alpha are left as they are (their colour's alpha handling differs in
+    float images)."""
+    for n in mat.node_tree.nodes:
+        im = n.image if n.type == "TEX_IMAGE" else None
+        if im is None or im.is_float or im.colorspace_settings.name != "sRGB":
+            continue
+        w, h = im.size
+        px = array.array("f", [0.0]) * (w * h * 4)
+        im.pixels.foreach_get(px)
+        if any(px[i] < 1.0 for i in range(3, len(px), 4)):
+            continue
+        for i in range(len(px)):
+            if i % 4 != 3:
+                c = px[i]
+                px[i] = c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+        lin = bpy.data.images.new(im.name + " (linear)", w, h, alpha=True, float_buffer=True)
+        lin.colorspace_settings.name = "Linear"
+        lin.pixels.foreach_set(px)
+        n.image = lin
+        LINEARISED[0] += 1
+
+
+def fix_emissive_factor(mat, p):
+    """Blender 3.4.1's importer multiplies an emissive texture by a non-grey emissiveFactor in a
+    Mix node (RGBA, MULTIPLY) but links the node's first output, its float Result, which the
+    RGBA mode leaves unused (0): the emission came out black.  Its colour Result is linked
+    instead (the base colour's Color Factor node is linked that way by the importer itself)."""
+    e = p.inputs["Emission"]
+    if not e.is_linked:
+        return
+    link = e.links[0]
+    node = link.from_node
+    if node.type == "MIX" and node.data_type == "RGBA" and \
+            link.from_socket.identifier != "Result_Color":
+        colour = [o for o in node.outputs if o.identifier == "Result_Color"]
+        if len(colour) != 1:
+            fail("imported material %s: its emissive factor's Mix node has no colour Result"
+                 % mat.name)
+        mat.node_tree.links.new(colour[0], e)
+        FIXED_EMISSION[0] += 1
+
+
+def mask_alpha(mat, p):
+    """glTF's MASK, which Blender 3.4's importer leaves as the blend method CLIP with the cutoff
+    as alpha_threshold, both EEVEE's only: Cycles would read the Principled Alpha as a
+    fraction.  Here Alpha becomes 1 where the imported alpha (the base-colour texture's alpha,
+    times the factor's) is at or above the cutoff, 0 below it: a hole, which every Cycles ray
+    (shadow rays too) passes, as zonetrace's.  The cutoff is clamped into [0, 1], as
+    zonetrace does."""
+    nt = mat.node_tree
+    cutoff = min(1.0, max(0.0, mat.alpha_threshold))
+    alpha = p.inputs["Alpha"]
+    if not alpha.is_linked:
+        alpha.default_value = 1.0 if alpha.default_value >= cutoff else 0.0
+        return
+    src = alpha.links[0].from_socket
+    below = nt.nodes.new("ShaderNodeMath")
+    below.operation = "LESS_THAN"
+    below.label = "alpha below the cutoff"
+    below.inputs[1].default_value = cutoff
+    step = nt.nodes.new("ShaderNodeMath")
+    step.operation = "SUBTRACT"
+    step.label = "MASK: 1 at or above the cutoff"
+    step.inputs[0].default_value = 1.0
+    nt.links.new(src, below.inputs[0])
+    nt.links.new(below.outputs[0], step.inputs[1])
+    nt.links.new(step.outputs[0], alpha)
+    MASKED[0] += 1
+
+
+def imported_emission(mat):
+    """Whether an imported material emits (its Principled Emission times Strength)."""
+    p = [n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED"][0]
+    e, k = p.inputs["Emission"], p.inputs["Emission Strength"]
+    return (k.is_linked or k.default_value > 0) and (e.is_linked or any(e.default_value[:3]))
+
+
 def prepare_imported_material(mat, args):
     """Keeps Blender's Principled BSDF as imported; sets the distribution (--ggx) and, as a
     diagnostic, the dielectric specular layer off (--no-dielectric-specular)."""
@@ -850,6 +989,14 @@ def prepare_imported_material(mat, args):
         fail("imported material %s: %d Principled BSDFs (one expected)" % (mat.name, len(bsdfs)))
     p = bsdfs[0]
     p.distribution = GGX_KIND[0]
+    fix_emissive_factor(mat, p)
+    if mat.blend_method == "CLIP":
+        mask_alpha(mat, p)
+    elif mat.blend_method != "OPAQUE":
+        fail("imported material %s: blend method %s (only OPAQUE and MASK are supported)"
+             % (mat.name, mat.blend_method))
+    if args.linear_filtering:
+        linear_textures(mat)
     if args.no_dielectric_specular:
         spec = p.inputs["Specular"]
         if spec.is_linked:
@@ -919,6 +1066,24 @@ def add_model(item, index, scene_dir, ctx, args):
             if slot.material.name not in own:
                 own[slot.material.name] = slot.material
                 prepare_imported_material(slot.material, args)
+    emissive = {name for name, im in own.items() if imported_emission(im)}
+    for o in objs:
+        if o.type != "MESH" or mat is not None:
+            continue
+        # Emissive triangles are mesh lights in Cycles, sampled by solid angle (inexactly)
+        # from within edge x twice the area of their plane (see build_object): said, not cut.
+        mw = o.matrix_world
+        for poly in o.data.polygons:
+            slot = o.material_slots[poly.material_index].material
+            if slot is None or slot.name not in emissive:
+                continue
+            pts = [mw @ o.data.vertices[v].co for v in poly.vertices]
+            edge = max((pts[i] - pts[i - 1]).length for i in range(len(pts)))
+            twice_area = sum(((pts[i] - pts[0]).cross(pts[i + 1] - pts[0])).length
+                             for i in range(1, len(pts) - 1))
+            ctx["model_light_faces"] += 1
+            ctx["model_solid_angle_within"] = max(ctx["model_solid_angle_within"],
+                                                  edge * twice_area / UNIT[0])
     if backculled:
         for im in own.values():  # each import makes its own materials
             backface_transparent(im)
@@ -1183,7 +1348,11 @@ def render_settings(s, w, h, pixel_aspect, args):
     b = args.bounces
     c.max_bounces = b
     c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = b
-    c.volume_bounces = c.transparent_max_bounces = b
+    c.volume_bounces = b
+    # Transparent passes (alpha-MASK holes, backculled backs) are not scatterings in zonetrace:
+    # they must not end paths at --bounces (with --bounces 0 they would block the camera's
+    # rays through the holes and every shadow ray crossing them).
+    c.transparent_max_bounces = max(b, 64)
     c.min_light_bounces = 0
     c.min_transparent_bounces = 0
     s.view_settings.view_transform = "Standard"
@@ -1242,6 +1411,10 @@ def main(argv):
                     help="rough lobes: Multiscatter GGX (default), or single-scattering GGX "
                          "(to compare with a zonetrace built without its compensation)")
     ap.add_argument("--threads", type=int, default=0, help="render threads (0: all)")
+    ap.add_argument("--linear-filtering", action="store_true",
+                    help="diagnostic: the imported sRGB textures without alpha (emissive, base "
+                         "colour) made linear before Cycles filters them, as zonetrace (and "
+                         "glTF) filter; Cycles filters the 8-bit sRGB codes")
     ap.add_argument("--no-dielectric-specular", action="store_true",
                     help="diagnostic: the imported Principled BSDFs' Specular set to 0, leaving "
                          "out glTF's specular layer over non-metals (F0 0.04), which zonetrace "
@@ -1316,7 +1489,8 @@ def main(argv):
     ctx = {"materials": {}, "view_centre": view_centre, "plane_size": args.plane_size,
            "cam_points": cam_points, "sphere_k": args.sphere_subdivisions, "spheres": {},
            "mesh_spheres": 0, "light_k": args.light_subdivisions, "light_pieces": 0,
-           "solid_angle_within": 0.0, "models": 0, "model_materials": 0}
+           "solid_angle_within": 0.0, "models": 0, "model_materials": 0,
+           "model_light_faces": 0, "model_solid_angle_within": 0.0}
     for o in objs:
         build_object(o, ctx)
     scene_dir = os.path.dirname(os.path.abspath(args.scene))
@@ -1339,6 +1513,20 @@ def main(argv):
               % (ctx["models"], ctx["model_materials"], GGX_KIND[0],
                  ", Specular 0: no dielectric layer (diagnostic)" if args.no_dielectric_specular
                  else ""))
+    if MASKED[0]:
+        print("cycles_reference: %d imported MASK materials: Principled Alpha made 1 at or above "
+              "alphaCutoff, 0 below (Cycles ignores the CLIP blend method)" % MASKED[0])
+    if LINEARISED[0]:
+        print("cycles_reference: %d imported sRGB textures made linear before filtering "
+              "(--linear-filtering, a diagnostic)" % LINEARISED[0])
+    if FIXED_EMISSION[0]:
+        print("cycles_reference: %d imported emissive factors relinked (Blender 3.4.1's importer "
+              "links its Mix node's float Result, 0, to the Emission)" % FIXED_EMISSION[0])
+    if ctx["model_light_faces"]:
+        print("cycles_reference: %d emissive model faces (Principled Emission x Strength, "
+              "radiance): Cycles samples their solid angle (inexactly) within %.3g scene units "
+              "of their planes (not cut: give the model small emissive triangles)"
+              % (ctx["model_light_faces"], ctx["model_solid_angle_within"]))
     if ctx["light_pieces"]:
         print("cycles_reference: scale %g; light triangles cut into %d pieces: Cycles samples "
               "their solid angle (inexactly) only within %.3g scene units of their planes"
