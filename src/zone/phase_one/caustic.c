@@ -722,25 +722,16 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
     }
     f->rays += rays;
     if (over) {
-        for (int k = 0; k < njobs; k++) {
-            free(jobs[k].out.d);
-            photon_map_free(&jobs[k].out.photons);
-        }
-        free(targets);
-        free(pairs);
-        free(jobs);
-        free(acc);
-        free(area);
         char a[32], b[32];
-        return zt_fail(err, ZT_ERR_MEMORY, "the zone tracer's caustic photons at quality %d outgrew the "
-                       "%s of memory left under the limit of %s (%s): glass splits photons, and "
-                       "more were stored than the %llu traced that the estimate counts; use a "
-                       "lower quality or a higher limit",
-                       r->options.quality, memory_format(limit - base, a, sizeof a),
-                       memory_format(limit, b, sizeof b), source, (unsigned long long)traced);
+        st = zt_fail(err, ZT_ERR_MEMORY, "the zone tracer's caustic photons at quality %d outgrew "
+                     "the %s of memory left under the limit of %s (%s): glass splits photons, and "
+                     "more were stored than the %llu traced that the estimate counts; use a "
+                     "lower quality or a higher limit",
+                     r->options.quality, memory_format(limit - base, a, sizeof a),
+                     memory_format(limit, b, sizeof b), source, (unsigned long long)traced);
     }
     /* Sums in job order, in double precision, then onto the nodes. */
-    int failed = 0;
+    int failed = over;
     for (int k = 0; k < njobs && !failed; k++) {
         const deposits *o = &jobs[k].out;
         failed = o->failed;
@@ -820,5 +811,7 @@ zt_status caustic_build(zone_forest *f, const zt_renderer *r, zt_error *err)
     free(jobs);
     free(pairs);
     free(targets);
+    if (over)
+        return st;
     return failed ? zt_fail(err, ZT_ERR_MEMORY, "out of memory for caustics") : ZT_OK;
 }
