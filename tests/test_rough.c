@@ -221,6 +221,63 @@ static void test_sun_through_rough_glass(void **state)
     }
 }
 
+/* A coloured rough metal under the sun: the metallic lobe's Fresnel is
+ * Schlick's (F0 = R0 from the index, times the colour c), and the light
+ * single scattering loses is put back with F0 = c R0 in each channel
+ * (Turquin 2019): c F f cos (1 + c R0 (1 - E) / E), E the white lobe's
+ * albedo at wo.  A white lobe's gain would give dark channels too much (at
+ * roughness 0.8, blue 0.2 here about 30%). */
+static void test_sun_coloured_metal(void **state)
+{
+    (void)state;
+    const double color[3] = {0.9, 0.5, 0.2}, ior = 0.01, r = 0.8, th = 0.53 / 2 * PI / 180;
+    const double r0 = (ior - 1) * (ior - 1) / ((ior + 1) * (ior + 1));
+    d3 s = unit(mk(0.3, 0.8, 0.2)), wo = unit(mk(-0.3, 0.7, -0.1));
+    /* The plane's frame: z is the world's y. */
+    d3 sl = mk(s.x, s.z, s.y), wl = mk(wo.x, wo.z, wo.y);
+    double a = r * r, e = albedo(wl, a, 0);
+    /* The sun through the uncompensated lobe, with Schlick's Fresnel. */
+    d3 u = unit(fabs(sl.x) < 0.9 ? mk(sl.z, 0, -sl.x) : mk(0, sl.z, -sl.y));
+    d3 v = mk(sl.y * u.z - sl.z * u.y, sl.z * u.x - sl.x * u.z, sl.x * u.y - sl.y * u.x);
+    const int nr = 200, np = 200;
+    double sum = 0, ct_min = cos(th);
+    for (int i = 0; i < nr; i++) {
+        double ct = 1 - (1 - ct_min) * (i + 0.5) / nr, st = sqrt(1 - ct * ct);
+        for (int j = 0; j < np; j++) {
+            double p = 2 * PI * (j + 0.5) / np;
+            d3 wi = add(scale(sl, ct), add(scale(u, st * cos(p)), scale(v, st * sin(p))));
+            double ch = dot(wl, unit(add(wl, wi)));
+            sum += lobe(wl, wi, a, 0) * (r0 + (1 - r0) * pow(1 - ch, 5));
+        }
+    }
+    double single = 100 / (PI * sin(th) * sin(th)) * sum * 2 * PI * (1 - ct_min) / (nr * np);
+    char text[1536];
+    snprintf(text, sizeof text,
+             "{\"scene\": [{\"sun\": {\"direction\": [%.17g, %.17g, %.17g], \"irradiance\": "
+             "[100, 100, 100], \"angle\": 0.53}}, {\"plane\": {\"normal\": [0, 1, 0], \"offset\": 0, "
+             "\"material\": {\"character\": {\"diffuse\": 0, \"metallic\": 1, \"reflecting\": 0, "
+             "\"refractive\": 0}, \"color\": [%g, %g, %g], \"refractiveindex\": %g, \"roughness\": "
+             "%g}}}], \"camera\": {\"position\": [%.17g, %.17g, %.17g], \"lookat\": [0, 0, 0], "
+             "\"fov\": 0.5, \"gridresolution\": [8, 8]}}",
+             s.x, s.y, s.z, color[0], color[1], color[2], ior, r, 3 * wo.x, 3 * wo.y, 3 * wo.z);
+    zt_scene *sc = test_scene_text(text, "rough_metal_sun");
+    for (int mi = 0; mi < 2; mi++) {
+        zt_image *im = test_render_level(sc, methods[mi], 1, 1, 256);
+        for (int c = 0; c < 3; c++) {
+            double got = 0;
+            for (int i = 0; i < im->width * im->height; i++)
+                got += im->pixels[3 * i + c];
+            got /= im->width * im->height;
+            double want = color[c] * single * (1 + color[c] * r0 * (1 - e) / e);
+            print_message("%s: sun on a rough metal of colour %.1f: %.5g, formula %.5g\n",
+                          method_name[mi], color[c], got, want);
+            assert_true(fabs(got / want - 1) < 0.01);
+        }
+        zt_image_release(im);
+    }
+    zt_scene_release(sc);
+}
+
 /* The zone tracer's white furnace: a rough mirror sphere under a white sky
  * sends it back whole at its first bounce (the lobe's lost energy put
  * back), read over the lobe's directions. */
@@ -249,6 +306,7 @@ int main(void)
         cmocka_unit_test(test_roughness_zero),
         cmocka_unit_test(test_sun_rough_mirror),
         cmocka_unit_test(test_sun_through_rough_glass),
+        cmocka_unit_test(test_sun_coloured_metal),
         cmocka_unit_test(test_zone_furnace),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -108,6 +108,16 @@ static float mirror_factor(const rs_object *m, int lobe, float cos_o, float cos_
     return bsdf_schlick(cos_h, m->ior) * (1.0f + f0 * (1.0f - e) / e);
 }
 
+vec3f bsdf_metal_tint(const rs_object *m, vec3f color, float cos_o)
+{
+    if (!bsdf_lobe_rough(m, LOBE_METALLIC) || !(cos_o > 0.0f))
+        return f3_splat(1.0f);
+    float e = ggx_albedo_mirror(cos_o, m->alpha);
+    float fk = bsdf_schlick(1.0f, m->ior) * (1.0f - e) / e;
+    return f3((1.0f + color.x * fk) / (1.0f + fk), (1.0f + color.y * fk) / (1.0f + fk),
+              (1.0f + color.z * fk) / (1.0f + fk));
+}
+
 void bsdf_eval_rough(const rs_object *m, const shading_frame *f, vec3f wo, vec3f wi,
                      float eta_i, float eta_t, float fcos[LOBE_COUNT], float pdf[LOBE_COUNT])
 {
@@ -231,6 +241,8 @@ static int bsdf_sample_rough(const rs_object *m, int lobe, const shading_frame *
         return 0;
     out->wi = f3_normalize(from_local(f, i));
     out->weight = f3_scale(m->color, ggx_g2(o, i, a) / g1 * gain);
+    if (lobe == LOBE_METALLIC)
+        out->weight = f3_mul(out->weight, bsdf_metal_tint(m, m->color, o.z));
     out->pdf = m->weight[lobe] * g1 * d / (4.0f * o.z) * choice;
     return out->pdf > 0.0f;
 }

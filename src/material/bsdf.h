@@ -114,6 +114,16 @@ static inline float bsdf_smooth_weight(const rs_object *m, int k)
 void bsdf_eval_rough(const rs_object *m, const shading_frame *f, vec3f wo, vec3f wi,
                      float eta_i, float eta_t, float fcos[LOBE_COUNT], float pdf[LOBE_COUNT]);
 
+/* What the rough metallic lobe's fcos (bsdf_eval_rough) is to be
+ * multiplied by, per channel, besides its colour: mirror_factor puts back
+ * the light single scattering loses as a white lobe would (Turquin 2019,
+ * 1 + F0 (1 - E) / E, F0 = the Fresnel's f0), where a coloured metal's F0
+ * is its colour times f0 in each channel, and a second scattering inside
+ * the roughness takes its colour twice: (1 + c f0 k) / (1 + f0 k), with
+ * k = (1 - E) / E at cos_o (the shading normal's cosine with wo).  1
+ * for white, and where the metallic lobe is smooth. */
+vec3f bsdf_metal_tint(const rs_object *m, vec3f color, float cos_o);
+
 /* Samples a direction from m's rough lobes among `lobes` (a mask of 1 << k),
  * one of them chosen by u_lobe in proportion to its weight; the rest as
  * for bsdf_sample_material.  Only out->wi, ->transmit and ->delta are of

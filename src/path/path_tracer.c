@@ -60,12 +60,18 @@ static vec3f nee_rough(const rs_object *m, const shading_frame *frame, vec3f n, 
 {
     if ((f3_dot(n, wi) > 0.0f) != (f3_dot(frame->n, wi) > 0.0f))
         return f3_splat(0.0f);
-    float fcos[LOBE_COUNT], pdf[LOBE_COUNT], sum = 0.0f;
+    float fcos[LOBE_COUNT], pdf[LOBE_COUNT], sum = 0.0f, metal = 0.0f;
     bsdf_eval_rough(m, frame, wo, wi, eta_i, eta_t, fcos, pdf);
     for (int k = 0; k < LOBE_COUNT; k++)
-        if (fcos[k] > 0.0f)
-            sum += fcos[k] * (light_delta ? 1.0f / p_light : power_heuristic_over(p_light, pdf[k]));
-    return f3_scale(m->color, sum);
+        if (fcos[k] > 0.0f) {
+            float v = fcos[k] * (light_delta ? 1.0f / p_light : power_heuristic_over(p_light, pdf[k]));
+            if (k == LOBE_METALLIC)
+                metal = v;
+            else
+                sum += v;
+        }
+    vec3f tint = bsdf_metal_tint(m, m->color, f3_dot(frame->n, wo));
+    return f3_mul(m->color, f3_add(f3_splat(sum), f3_scale(tint, metal)));
 }
 
 path_pixel path_pixel_make(uint32_t key)

@@ -370,6 +370,6 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
 /* One direction *wi from s's rough lobes, chosen by a hash of the point
  * and the arriving direction, and *value, their f cos over its density
  * (the colour apart): how a caustic photon goes on.  0: none. */
-int zone_rough_scatter(const zone_rough_at *s, vec3f *wi, float *value);
+int zone_rough_scatter(const zone_rough_at *s, vec3f *wi, vec3f *value);
 
 #endif

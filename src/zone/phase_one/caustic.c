@@ -161,16 +161,16 @@ static void rough_on(tracer *t, const rs_part *p, int part, const rs_object *m,
     const rs_shade *sh = known ? known : &own;
     zone_rough_at at = {m,     part,  xf,       nf,         sh->ns, f3_to_v3(sh->albedo), d,
                         eta_i, eta_t, p->object, entering, media, media_count};
-    vec3f wi;
-    float value;
+    vec3f wi, value;
     if (!zone_rough_scatter(&at, &wi, &value))
         return;
     int through = f3_dot(wi, nf) < 0.0f;
     /* Flux crosses the surface without the radiance's (eta_i/eta_t)^2. */
     if (through)
-        value *= (eta_t / eta_i) * (eta_t / eta_i);
-    vec3 out = v3_scale(v3_mul(flux, at.color), value);
-    double sp = share * value * v3_max(at.color);
+        value = f3_scale(value, (eta_t / eta_i) * (eta_t / eta_i));
+    vec3 tint = v3_mul(at.color, f3_to_v3(value));
+    vec3 out = v3_mul(flux, tint);
+    double sp = share * v3_max(tint);
     if (sp < BRANCH_MIN)
         return;
     if (!through) {

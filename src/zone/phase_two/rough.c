@@ -120,21 +120,27 @@ static double hashed_index(vec3f x, vec3f d)
 /* The lobes' f cos summed (colour apart) and their mixture's density of
  * direction wi; 0 when wi lies on the other side of the geometric normal
  * than of the shading normal (light would leak). */
-static float lobes_eval(const zone_rough_at *s, const shading_frame *fr, unsigned lobes,
-                        float weight_sum, vec3f wi, float *pdf)
+static vec3f lobes_eval(const zone_rough_at *s, const shading_frame *fr, unsigned lobes,
+                         float weight_sum, vec3f wi, float *pdf)
 {
     *pdf = 0.0f;
     if ((f3_dot(s->ng, wi) > 0.0f) != (f3_dot(fr->n, wi) > 0.0f))
-        return 0.0f;
-    float fcos[LOBE_COUNT], p[LOBE_COUNT], f = 0.0f, sum = 0.0f;
+        return f3_splat(0.0f);
+    float fcos[LOBE_COUNT], p[LOBE_COUNT], f = 0.0f, metal = 0.0f, sum = 0.0f;
     bsdf_eval_rough(s->m, fr, f3_neg(s->d), wi, s->eta_i, s->eta_t, fcos, p);
     for (int k = 0; k < LOBE_COUNT; k++)
         if (lobes >> k & 1u) {
-            f += fcos[k];
+            if (k == LOBE_METALLIC)
+                metal = fcos[k];
+            else
+                f += fcos[k];
             sum += p[k];
         }
     *pdf = sum / weight_sum;
-    return f;
+    if (metal == 0.0f)
+        return f3_splat(f);
+    vec3f tint = bsdf_metal_tint(s->m, v3_to_f3(s->color), -f3_dot(fr->n, s->d));
+    return f3_add(f3_splat(f), f3_scale(tint, metal));
 }
 
 /* Level 0 by light samples: the lights (not under ZR_NO_CAUSTIC: photons
@@ -149,8 +155,9 @@ static vec3 light_samples(zone_trace *t, const zone_rough_at *s, const shading_f
     light_sample ls;
     if (!(flags & ZR_NO_CAUSTIC) && rs->light_count > 0 &&
         light_sample_point(rs, s->x, pn->light, u2, &ls) && !f3_is_black(ls.li)) {
-        float pdf, f = lobes_eval(s, fr, lobes, weight_sum, ls.wi, &pdf);
-        if (f > 0.0f) {
+        float pdf;
+        vec3f f = lobes_eval(s, fr, lobes, weight_sum, ls.wi, &pdf);
+        if (f3_max(f) > 0.0f) {
             int below = f3_dot(s->ng, ls.wi) < 0.0f;
             vec3f from = ray_offset(s->x, below ? f3_neg(s->ng) : s->ng);
             vec3f y = f3_madd(s->x, ls.wi, ls.dist);
@@ -162,7 +169,7 @@ static vec3 light_samples(zone_trace *t, const zone_rough_at *s, const shading_f
                                            shadow_ray_end(from, y, dist_y), lp->background);
             t->rays++;
             float w = ls.delta ? 1.0f / ls.pdf : power_heuristic_over(ls.pdf, pdf);
-            out = v3_add(out, f3_to_v3(f3_scale(f3_mul(ls.li, tr), f * w)));
+            out = v3_add(out, f3_to_v3(f3_mul(f3_mul(ls.li, tr), f3_scale(f, w))));
         }
     }
     vec3f wi, li;
@@ -175,14 +182,15 @@ static vec3 light_samples(zone_trace *t, const zone_rough_at *s, const shading_f
         li = f3(f_max0(li.x), f_max0(li.y), f_max0(li.z));
     }
     if (got && !f3_is_black(li)) {
-        float pdf, f = lobes_eval(s, fr, lobes, weight_sum, wi, &pdf);
-        if (f > 0.0f) {
+        float pdf;
+        vec3f f = lobes_eval(s, fr, lobes, weight_sum, wi, &pdf);
+        if (f3_max(f) > 0.0f) {
             int below = f3_dot(s->ng, wi) < 0.0f;
             vec3f tr = accel_transmittance(rs, ray_offset(s->x, below ? f3_neg(s->ng) : s->ng),
                                            wi, FLT_MAX, 1);
             t->rays++;
-            out = v3_add(out, f3_to_v3(f3_scale(f3_mul(li, tr),
-                                                f * power_heuristic_over(far_pdf, pdf))));
+            out = v3_add(out, f3_to_v3(f3_mul(f3_mul(li, tr),
+                                              f3_scale(f, power_heuristic_over(far_pdf, pdf)))));
         }
     }
     return out;
@@ -212,7 +220,7 @@ static void frame_of(const zone_rough_at *s, shading_frame *fr)
  * density (0 for the straight line of an index-matched glass, whose value
  * is 1). */
 static int scatter(const zone_rough_at *s, const shading_frame *fr, unsigned lobes,
-                   float weight_sum, const point_numbers *pn, vec3f *wi, float *pdf, float *value)
+                   float weight_sum, const point_numbers *pn, vec3f *wi, float *pdf, vec3f *value)
 {
     bsdf_sample bs;
     if (!bsdf_sample_rough_lobes(s->m, lobes, fr, f3_neg(s->d), pn->choice, pn->split, pn->u2,
@@ -221,17 +229,17 @@ static int scatter(const zone_rough_at *s, const shading_frame *fr, unsigned lob
     *wi = bs.wi;
     if (bs.delta) {
         *pdf = 0.0f;
-        *value = 1.0f;
+        *value = f3_splat(1.0f);
         return 1;
     }
-    float f = lobes_eval(s, fr, lobes, weight_sum, bs.wi, pdf);
-    if (!(f > 0.0f) || !(*pdf > 0.0f))
+    vec3f f = lobes_eval(s, fr, lobes, weight_sum, bs.wi, pdf);
+    if (!(f3_max(f) > 0.0f) || !(*pdf > 0.0f))
         return 0;
-    *value = f / *pdf;
+    *value = f3_scale(f, 1.0f / *pdf);
     return 1;
 }
 
-int zone_rough_scatter(const zone_rough_at *s, vec3f *wi, float *value)
+int zone_rough_scatter(const zone_rough_at *s, vec3f *wi, vec3f *value)
 {
     float weight_sum, pdf;
     unsigned lobes = rough_lobes(s->m, ~0u, &weight_sum);
@@ -251,8 +259,8 @@ static vec3 lobe_ray(zone_trace *t, const zone_rough_at *s, const shading_frame 
                      unsigned lobes, float weight_sum, const point_numbers *pn, int lo, int hi,
                      int flags)
 {
-    vec3f wi;
-    float pdf, f;
+    vec3f wi, f;
+    float pdf;
     if (!scatter(s, fr, lobes, weight_sum, pn, &wi, &pdf, &f))
         return v3(0, 0, 0);
     int through = f3_dot(s->ng, wi) < 0.0f;
@@ -266,7 +274,7 @@ static vec3 lobe_ray(zone_trace *t, const zone_rough_at *s, const shading_frame 
     }
     t->mis_pdf = lo == 0 ? pdf : 0.0f;
     t->mis_from = s->x;
-    return v3_scale(zone_radiance(t, o, wi, lo, hi, flags, media, media_count), f);
+    return v3_mul(zone_radiance(t, o, wi, lo, hi, flags, media, media_count), f3_to_v3(f));
 }
 
 /* A camera sample's count of a pixel's `per_pixel` points: by its weight
