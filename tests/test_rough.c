@@ -63,10 +63,11 @@ static double albedo(d3 wo, double a, double eta)
 }
 
 /* Radiance from a sun disc of half-angle th around s, irradiance e (the
- * renderer's radiance e / (pi sin^2 th)), through the compensated lobe
- * toward wo; etap_radiance is the radiance factor of transmission. */
-static double sun_through_lobe(d3 wo, d3 s, double th, double e, double a, double eta,
-                               double etap_radiance)
+ * renderer's radiance e / (pi sin^2 th)), through the uncompensated lobe
+ * toward wo, times Schlick's Fresnel at the half vector with r0 when r0 >=
+ * 0; etap_radiance is the radiance factor of transmission. */
+static double sun_through_single(d3 wo, d3 s, double th, double e, double a, double eta,
+                                 double etap_radiance, double r0)
 {
     d3 u = unit(fabs(s.x) < 0.9 ? mk(s.z, 0, -s.x) : mk(0, s.z, -s.y));
     d3 v = mk(s.y * u.z - s.z * u.y, s.z * u.x - s.x * u.z, s.x * u.y - s.y * u.x);
@@ -78,12 +79,21 @@ static double sun_through_lobe(d3 wo, d3 s, double th, double e, double a, doubl
             double p = 2 * PI * (j + 0.5) / np;
             d3 wi = add(scale(s, ct), add(scale(u, st * cos(p)), scale(v, st * sin(p))));
             double f = lobe(wo, wi, a, eta);
+            if (r0 >= 0)
+                f *= r0 + (1 - r0) * pow(1 - dot(wo, unit(add(wo, wi))), 5);
             sum += wi.z > 0 ? f : f * etap_radiance;
         }
     }
     double solid = 2 * PI * (1 - ct_min);
     double radiance = e / (PI * sin(th) * sin(th));
-    return radiance * sum * solid / (nr * np) / albedo(wo, a, eta);
+    return radiance * sum * solid / (nr * np);
+}
+
+/* The same through the compensated white lobe (F = 1 or the dielectric's). */
+static double sun_through_lobe(d3 wo, d3 s, double th, double e, double a, double eta,
+                               double etap_radiance)
+{
+    return sun_through_single(wo, s, th, e, a, eta, etap_radiance, -1) / albedo(wo, a, eta);
 }
 
 #define SPHERE_SCENE "{\"scene\": [{\"sky\": {\"color\": [1, 1, 1]}}, {\"sphere\": {\"center\": " \
@@ -236,21 +246,7 @@ static void test_sun_coloured_metal(void **state)
     /* The plane's frame: z is the world's y. */
     d3 sl = mk(s.x, s.z, s.y), wl = mk(wo.x, wo.z, wo.y);
     double a = r * r, e = albedo(wl, a, 0);
-    /* The sun through the uncompensated lobe, with Schlick's Fresnel. */
-    d3 u = unit(fabs(sl.x) < 0.9 ? mk(sl.z, 0, -sl.x) : mk(0, sl.z, -sl.y));
-    d3 v = mk(sl.y * u.z - sl.z * u.y, sl.z * u.x - sl.x * u.z, sl.x * u.y - sl.y * u.x);
-    const int nr = 200, np = 200;
-    double sum = 0, ct_min = cos(th);
-    for (int i = 0; i < nr; i++) {
-        double ct = 1 - (1 - ct_min) * (i + 0.5) / nr, st = sqrt(1 - ct * ct);
-        for (int j = 0; j < np; j++) {
-            double p = 2 * PI * (j + 0.5) / np;
-            d3 wi = add(scale(sl, ct), add(scale(u, st * cos(p)), scale(v, st * sin(p))));
-            double ch = dot(wl, unit(add(wl, wi)));
-            sum += lobe(wl, wi, a, 0) * (r0 + (1 - r0) * pow(1 - ch, 5));
-        }
-    }
-    double single = 100 / (PI * sin(th) * sin(th)) * sum * 2 * PI * (1 - ct_min) / (nr * np);
+    double single = sun_through_single(wl, sl, th, 100, a, 0, 1, r0);
     char text[1536];
     snprintf(text, sizeof text,
              "{\"scene\": [{\"sun\": {\"direction\": [%.17g, %.17g, %.17g], \"irradiance\": "

@@ -70,6 +70,8 @@ static vec3f nee_rough(const rs_object *m, const shading_frame *frame, vec3f n, 
             else
                 sum += v;
         }
+    if (metal == 0.0f)
+        return f3_scale(m->color, sum);
     vec3f tint = bsdf_metal_tint(m, m->color, f3_dot(frame->n, wo));
     return f3_mul(m->color, f3_add(f3_splat(sum), f3_scale(tint, metal)));
 }
