@@ -358,6 +358,35 @@ static void test_mtl_materials(void **state)
     zt_scene_release(s);
 }
 
+
+/* Formats without materials (PLY, STL, OFF) and an OBJ without its MTL get
+ * the default light grey, not the white or grey Assimp invents for them;
+ * a white the file states is kept. */
+static void test_invented_materials_grey(void **state)
+{
+    (void)state;
+    test_write_file("bare.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                "property float y\nproperty float z\nelement face 1\n"
+                                "property list uchar int vertex_indices\nend_header\n"
+                                "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    test_write_file("bare.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    test_write_file("white.mtl", "newmtl white\nKd 1 1 1\n");
+    test_write_file("white.obj", "mtllib white.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                 "usemtl white\nf 1 2 3\n");
+    const char *models[3] = {"bare.ply", "bare.obj", "white.obj"};
+    const double want[3] = {0.8, 0.8, 1.0};
+    for (int k = 0; k < 3; k++) {
+        zt_scene *s = load_ok(write_scene("s_invented.json", models[k], ""));
+        const mesh *m = only_mesh(s);
+        assert_int_equal(m->slot_count, 1);
+        const material *mat = &m->slots[0].mat;
+        assert_true(mat->weight[LOBE_DIFFUSE] == 1.0);
+        assert_true(fabs(mat->color.x - want[k]) < 1e-6 && fabs(mat->color.y - want[k]) < 1e-6 &&
+                    fabs(mat->color.z - want[k]) < 1e-6);
+        zt_scene_release(s);
+    }
+}
+
 /* ---------------------------------------------------------------------- */
 /* Textures */
 
@@ -607,6 +636,7 @@ int main(void)
         cmocka_unit_test(test_transform_points),
         cmocka_unit_test(test_transform_errors),
         cmocka_unit_test(test_mtl_materials),
+        cmocka_unit_test(test_invented_materials_grey),
         cmocka_unit_test(test_texture_texels_and_lookup),
         cmocka_unit_test(test_texture_rendered),
         cmocka_unit_test(test_missing_texture_noted),

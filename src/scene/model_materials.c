@@ -345,6 +345,17 @@ static int has_extension(const char *path, const char *a, const char *b)
     return dot && (strcasecmp(dot, a) == 0 || (b && strcasecmp(dot, b) == 0));
 }
 
+/* A material the file did not state: Assimp's default (a model without
+ * materials, an OBJ without its MTL) or any material of a format that has
+ * none.  Its slot keeps the default, light grey: Assimp's white for PLY and
+ * STL made a model under the white sky nearly invisible (its albedo 1). */
+static int invented_material(const struct aiMaterial *am, int no_materials)
+{
+    struct aiString name;
+    return no_materials || (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS &&
+                            strcmp(name.data, AI_DEFAULT_MATERIAL_NAME) == 0);
+}
+
 zt_status model_materials(const struct aiScene *sc, const char *path,
                           const int *slot_of_material, int slot_count, mesh *m, zt_error *err)
 {
@@ -373,6 +384,9 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
     char folder[4096];
     folder_of(path, folder, sizeof folder);
     int gltf = has_extension(path, ".gltf", ".glb"), obj = has_extension(path, ".obj", NULL);
+    /* Formats without materials: Assimp invents one (PLY's and STL's
+     * white, OFF's 0.6 grey), which is not the file's. */
+    int no_materials = has_extension(path, ".ply", ".stl") || has_extension(path, ".off", NULL);
     model_textures tx = {sc, folder, path, m, names, (int)capacity};
     /* Assimp 5.2 drops KHR_materials_emissive_strength: read from the
      * file, by material index (Assimp keeps glTF's order; its default
@@ -389,7 +403,8 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
     zt_status st = ZT_OK;
     for (unsigned i = 0; i < sc->mNumMaterials && st == ZT_OK; i++) {
         int s = slot_of_material[i];
-        if (s < 0 || s >= slot_count || !sc->mMaterials[i])
+        if (s < 0 || s >= slot_count || !sc->mMaterials[i] ||
+            invented_material(sc->mMaterials[i], no_materials))
             continue;
         map_material(sc->mMaterials[i], gltf, obj, strength[i], &m->slots[s]);
         if (gltf)
