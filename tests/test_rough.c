@@ -23,15 +23,22 @@
 static double ggx_d(d3 h, double a) { return ggx_ref_d(h.z, a); }
 static double lambda(d3 w, double a) { return ggx_ref_lambda(w.z, a); }
 
+/* The clear coat's Fresnel: Schlick's with F0 = 0.04. */
+#define COAT (-1.0)
+static double coat_schlick(double c)
+{
+    return 0.04 + 0.96 * pow(1 - c, 5);
+}
+
 /* f |cos_i| of the white rough interface from wo (z > 0) to wi, without
  * compensation and, for transmission, in energy (no 1/eta^2); eta = 0 is
- * the mirror. */
+ * the mirror, COAT the clear coat over a diffuse base. */
 static double lobe(d3 wo, d3 wi, double a, double eta)
 {
     double g2 = 1 / (1 + lambda(wo, a) + lambda(wi, a));
     if (wi.z > 0) {
         d3 h = unit(add(wo, wi));
-        double f = eta > 0 ? fresnel(dot(wo, h), 1, eta) : 1;
+        double f = eta > 0 ? fresnel(dot(wo, h), 1, eta) : eta == COAT ? coat_schlick(dot(wo, h)) : 1;
         return f * ggx_d(h, a) * g2 / (4 * wo.z);
     }
     if (eta <= 0)
@@ -295,6 +302,75 @@ static void test_zone_furnace(void **state)
     }
 }
 
+/* A white diffuse sphere under a clear coat (specular 1) in a white
+ * furnace: the coat reflects s E(cos_o) and the base keeps the rest, so
+ * the sky comes back whole at the first bounce, in both renderers. */
+static void test_coat_furnace(void **state)
+{
+    (void)state;
+    const double rough[] = {0.0, 0.3, 1.0};
+    for (int i = 0; i < 3; i++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "{\"scene\": [{\"sky\": {\"color\": [1, 1, 1]}}, {\"sphere\": {\"center\": "
+                 "[0, 0, 0], \"radius\": 1, \"material\": {\"character\": {\"diffuse\": 1, "
+                 "\"metallic\": 0, \"reflecting\": 0, \"refractive\": 0}, \"color\": [1, 1, 1], "
+                 "\"specular\": 1, \"roughness\": %g}}}], \"camera\": {\"position\": [0, 0, 4], "
+                 "\"lookat\": [0, 0, 0], \"fov\": 30, \"gridresolution\": [32, 32]}}",
+                 rough[i]);
+        zt_scene *s = test_scene_text(text, "coat_furnace");
+        for (int mi = 0; mi < 2; mi++) {
+            zt_image *im = test_render_level(s, methods[mi], 1, 1, 256);
+            double mean = sphere_mean(im);
+            print_message("%s: white furnace, coated white sphere, roughness %.1f: %.5f\n",
+                          method_name[mi], rough[i], mean);
+            assert_true(fabs(mean - 1) < 0.005);
+            zt_image_release(im);
+        }
+        zt_scene_release(s);
+    }
+}
+
+/* A grey diffuse plane under a clear coat in the sun, seen from wo: the
+ * base's c/pi (1 - E(cos_o)) E cos_s plus the coat's GGX reflection of the
+ * sun's disc, E the coat's albedo at cos_o, both integrated here. */
+static void test_sun_on_coat(void **state)
+{
+    (void)state;
+    const double c = 0.5, r = 0.5, th = 0.53 / 2 * PI / 180, irr = 100;
+    d3 s = unit(mk(0.3, 0.8, 0.2));
+    /* Away from the highlight, and near it (the sun's mirror image). */
+    const d3 views[2] = {unit(mk(-0.3, 0.7, -0.1)), unit(mk(-0.35, 0.75, -0.2))};
+    for (int vi = 0; vi < 2; vi++) {
+    d3 wo = views[vi];
+    d3 sl = mk(s.x, s.z, s.y), wl = mk(wo.x, wo.z, wo.y);
+    double a = r * r, e = albedo(wl, a, COAT);
+    double want = c / PI * (1 - e) * irr * sl.z + sun_through_single(wl, sl, th, irr, a, COAT, 1, -1);
+    char text[1536];
+    snprintf(text, sizeof text,
+             "{\"scene\": [{\"sun\": {\"direction\": [%.17g, %.17g, %.17g], \"irradiance\": "
+             "[%g, %g, %g], \"angle\": 0.53}}, {\"plane\": {\"normal\": [0, 1, 0], \"offset\": 0, "
+             "\"material\": {\"character\": {\"diffuse\": 1, \"metallic\": 0, \"reflecting\": 0, "
+             "\"refractive\": 0}, \"color\": [%g, %g, %g], \"specular\": 1, \"roughness\": %g}}}], "
+             "\"camera\": {\"position\": [%.17g, %.17g, %.17g], \"lookat\": [0, 0, 0], "
+             "\"fov\": 0.5, \"gridresolution\": [8, 8]}}",
+             s.x, s.y, s.z, irr, irr, irr, c, c, c, r, 3 * wo.x, 3 * wo.y, 3 * wo.z);
+    zt_scene *sc = test_scene_text(text, "coat_sun");
+    for (int mi = 0; mi < 2; mi++) {
+        zt_image *im = test_render_level(sc, methods[mi], 1, 1, 256);
+        double got = 0;
+        for (int i = 0; i < im->width * im->height; i++)
+            got += im->pixels[3 * i];
+        got /= im->width * im->height;
+        print_message("%s: sun on a coated grey plane: %.5g, formula %.5g (coat albedo %.4f)\n",
+                      method_name[mi], got, want, e);
+        assert_true(fabs(got / want - 1) < 0.01);
+        zt_image_release(im);
+    }
+    zt_scene_release(sc);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -304,6 +380,8 @@ int main(void)
         cmocka_unit_test(test_sun_through_rough_glass),
         cmocka_unit_test(test_sun_coloured_metal),
         cmocka_unit_test(test_zone_furnace),
+        cmocka_unit_test(test_coat_furnace),
+        cmocka_unit_test(test_sun_on_coat),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -121,6 +121,8 @@ static const bad_case cases[] = {
     {"ior_negative", WITH_MATERIAL("{\"character\": " CHARACTER("0", "0", "0", "1") ", \"color\": [1, 1, 1], \"refractiveindex\": -1.5}"), 3, 0, "refractiveindex must be positive"},
     {"thin_without_glass", WITH_MATERIAL("{\"character\": " CHARACTER("1", "0", "0", "0") ", \"color\": [1, 1, 1], \"thin\": true}"), 3, 0, "weight is 0"},
     {"roughness_above_1", WITH_MATERIAL("{\"character\": " CHARACTER("0", "1", "0", "0") ", \"color\": [1, 1, 1], \"roughness\": 1.5}"), 3, 0, "roughness must be in [0, 1]"},
+    {"specular_above_1", WITH_MATERIAL("{\"character\": " CHARACTER("1", "0", "0", "0") ", \"color\": [1, 1, 1], \"specular\": 2}"), 3, 0, "specular must be in [0, 1]"},
+    {"specular_without_diffuse", WITH_MATERIAL("{\"character\": " CHARACTER("0", "1", "0", "0") ", \"color\": [1, 1, 1], \"specular\": 0.5}"), 3, 0, "coat over the diffuse lobe"},
     {"roughness_negative", WITH_MATERIAL("{\"character\": " CHARACTER("0", "1", "0", "0") ", \"color\": [1, 1, 1], \"roughness\": -0.1}"), 3, 0, "roughness must be in [0, 1]"},
     {"roughness_string", WITH_MATERIAL("{\"character\": " CHARACTER("0", "1", "0", "0") ", \"color\": [1, 1, 1], \"roughness\": \"rough\"}"), 3, 0, "number"},
     {"thin_not_bool", WITH_MATERIAL("{\"character\": " CHARACTER("0", "0", "0", "1") ", \"color\": [1, 1, 1], \"thin\": \"yes\"}"), 3, 0, "true or false"},

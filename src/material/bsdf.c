@@ -5,6 +5,8 @@
 static int bsdf_sample_rough(const rs_object *m, int lobe, const shading_frame *f, vec3f wo,
                              float u_split, const float u2[2], float eta_i, float eta_t,
                              bsdf_sample *out);
+static int sample_coat(const rs_object *m, const shading_frame *f, vec3f wo, float choice,
+                       const float u2[2], bsdf_sample *out);
 
 
 static vec3f reflect(vec3f wo, vec3f n)
@@ -44,6 +46,17 @@ int bsdf_sample_material(const rs_object *m, const shading_frame *f, vec3f wo, f
         return bsdf_sample_rough(m, lobe, f, wo, u_split, u2, eta_i, eta_t, out);
     switch (lobe) {
     case LOBE_DIFFUSE:
+        if (m->coat) {
+            /* u_lobe fell in [0, weight): its place there picks coat or
+             * base. */
+            float u = u_lobe / m->weight[LOBE_DIFFUSE], a = bsdf_coat_albedo(m, cos_o);
+            if (u < a)
+                return sample_coat(m, f, wo, a, u2, out);
+            if (!bsdf_sample_diffuse(m, f, u2, out))
+                return 0;
+            out->pdf *= 1.0f - a;
+            return out->pdf > 0.0f;
+        }
         return bsdf_sample_diffuse(m, f, u2, out);
     case LOBE_METALLIC:
         out->wi = reflect(wo, n);
@@ -138,6 +151,13 @@ void bsdf_eval_rough(const rs_object *m, const shading_frame *f, vec3f wo, vec3f
                 fcos[k] = m->weight[k] * base * g2 * mirror_factor(m, k, o.z, c);
                 pdf[k] = m->weight[k] * base * g1;
             }
+        if (m->coat) {
+            /* In the diffuse lobe's entries: the coat's (white). */
+            float ac = bsdf_coat_alpha(m), bc = ggx_d(h, ac) / (4.0f * o.z);
+            float w = m->weight[LOBE_DIFFUSE];
+            fcos[LOBE_DIFFUSE] = w * m->specular * bsdf_coat_fresnel(c) * bc * ggx_g2(o, i, ac);
+            pdf[LOBE_DIFFUSE] = w * bsdf_coat_albedo(m, o.z) * bc * ggx_g1(o, ac);
+        }
         if (bsdf_lobe_rough(m, LOBE_REFRACTIVE) && !index_matched(eta_i, eta_t)) {
             float fr = bsdf_fresnel_dielectric(c, eta_i, eta_t);
             float w = m->weight[LOBE_REFRACTIVE] * fr * base;
@@ -171,6 +191,8 @@ int bsdf_sample_rough_lobes(const rs_object *m, unsigned lobes, const shading_fr
                             float u_lobe, float u_split, const float u2[2], float eta_i,
                             float eta_t, bsdf_sample *out)
 {
+    if (lobes == 1u << LOBE_DIFFUSE)
+        return m->coat && sample_coat(m, f, wo, 1.0f, u2, out);
     float total = 0.0f;
     for (int k = 0; k < LOBE_COUNT; k++)
         if ((lobes >> k & 1u) && bsdf_lobe_rough(m, k))
@@ -244,5 +266,30 @@ static int bsdf_sample_rough(const rs_object *m, int lobe, const shading_frame *
     if (lobe == LOBE_METALLIC)
         out->weight = f3_mul(out->weight, bsdf_metal_tint(m, m->color, o.z));
     out->pdf = m->weight[lobe] * g1 * d / (4.0f * o.z) * choice;
+    return out->pdf > 0.0f;
+}
+
+/* The coat's direction (bsdf.h), chosen with probability `choice` once
+ * the diffuse lobe is: visible normals of its alpha; the weight is white. */
+static int sample_coat(const rs_object *m, const shading_frame *f, vec3f wo, float choice,
+                       const float u2[2], bsdf_sample *out)
+{
+    vec3f o = to_local(f, wo);
+    if (!(o.z > 0.0f) || !(choice > 0.0f))
+        return 0;
+    float a = bsdf_coat_alpha(m);
+    vec3f h = ggx_sample_vndf(o, a, u2);
+    float c = f3_dot(o, h);
+    if (!(c > 0.0f))
+        return 0;
+    vec3f i = f3_sub(f3_scale(h, 2.0f * c), o);
+    if (!(i.z > 0.0f))
+        return 0;
+    float g1 = ggx_g1(o, a);
+    out->wi = f3_normalize(from_local(f, i));
+    out->weight = f3_splat(m->specular * bsdf_coat_fresnel(c) * ggx_g2(o, i, a) / (g1 * choice));
+    out->pdf = m->weight[LOBE_DIFFUSE] * choice * g1 * ggx_d(h, a) / (4.0f * o.z);
+    out->delta = 0;
+    out->transmit = 0;
     return out->pdf > 0.0f;
 }

@@ -7,6 +7,7 @@
 #define ZT_MATERIAL_BSDF_H
 
 #include "material/fresnel.h"
+#include "material/microfacet.h"
 #include "render/render_scene.h"
 #include "util/sincos_turn.h"
 
@@ -30,8 +31,34 @@ typedef struct bsdf_sample {
     int transmit;   /* crossed the surface (refraction) */
 } bsdf_sample;
 
+/* The clear coat over the diffuse lobe (m->coat; docs/light-transport.md):
+ *
+ *   f_d(wo, wi) = s F(wo.h) D G2 / (4 cos_o cos_i)  +  (1 - s E(cos_o)) c / pi
+ *
+ * a GGX reflection of the material's alpha (at least GGX_ALPHA_MIN: a
+ * coat of roughness 0 is the narrowest lobe, not a delta) with Schlick's
+ * F (F0 = 0.04) scaled by s = m->specular, over the base, which gets what
+ * the coat does not reflect: E is the coat's albedo at cos_o, so a white
+ * base under light arriving evenly returns all of it.  The diffuse lobe,
+ * once chosen, picks the coat with probability s E(cos_o) and the base
+ * with the rest; the base's sample then weighs c, as without a coat. */
+static inline float bsdf_coat_alpha(const rs_object *m)
+{
+    return m->alpha > GGX_ALPHA_MIN ? m->alpha : GGX_ALPHA_MIN;
+}
+
+/* s E(cos_o): the share of evenly arriving light the coat reflects toward
+ * wo, which is also its probability of being sampled; 0 without a coat. */
+static inline float bsdf_coat_albedo(const rs_object *m, float cos_o)
+{
+    if (!m->coat || !(cos_o > 0.0f))
+        return 0.0f;
+    return m->specular * ggx_albedo_coat(cos_o, bsdf_coat_alpha(m));
+}
+
 /* f * cos of the diffuse lobe for unit wi, and its sampling density
- * (lobe choice included), where n faces the side the light arrives on. */
+ * (lobe choice included), where n faces the side the light arrives on.
+ * With a coat, the base's (bsdf_eval_base). */
 static inline vec3f bsdf_eval_diffuse(const rs_object *m, vec3f n, vec3f wi,
                                       float *pdf)
 {
@@ -43,6 +70,22 @@ static inline vec3f bsdf_eval_diffuse(const rs_object *m, vec3f n, vec3f wi,
     float w = m->weight[LOBE_DIFFUSE];
     *pdf = w * c * ZT_INV_PI;
     return f3_scale(m->color, *pdf);
+}
+
+/* The diffuse lobe's base under its coat (bsdf_coat_albedo) for light from
+ * wi leaving at cos_o (the shading normal's cosine with wo): f * cos and
+ * the density of the base's sample, both times 1 - s E(cos_o).  Without a
+ * coat, bsdf_eval_diffuse. */
+static inline vec3f bsdf_eval_base(const rs_object *m, vec3f n, vec3f wi, float cos_o,
+                                   float *pdf)
+{
+    vec3f fc = bsdf_eval_diffuse(m, n, wi, pdf);
+    if (m->coat) {
+        float keep = 1.0f - bsdf_coat_albedo(m, cos_o);
+        *pdf *= keep;
+        fc = f3_scale(fc, keep);
+    }
+    return fc;
 }
 
 static inline vec3f bsdf_cosine_hemisphere(const shading_frame *f, const float u[2])

@@ -15,6 +15,17 @@ static inline float bsdf_schlick(float cos_i, float ior)
     return r0 + (1.0f - r0) * m2 * m2 * m;
 }
 
+/* The clear layer over a diffuse base (a material's "specular", glTF's
+ * dielectric layer over non-metals): Schlick's Fresnel with F0 = 0.04 (an
+ * index of 1.5) and F90 = 1, which the layer's factor then scales. */
+#define BSDF_COAT_F0 0.04f
+static inline float bsdf_coat_fresnel(float cos_i)
+{
+    float m = 1.0f - f_clamp01(cos_i);
+    float m2 = m * m;
+    return BSDF_COAT_F0 + (1.0f - BSDF_COAT_F0) * m2 * m2 * m;
+}
+
 /* Unpolarised Fresnel reflectance of a smooth dielectric, going from index
  * eta_i into eta_t; 1 under total internal reflection. */
 static inline float bsdf_fresnel_dielectric(float cos_i, float eta_i, float eta_t)

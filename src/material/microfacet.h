@@ -73,5 +73,10 @@ static inline vec3f ggx_sample_vndf(vec3f wo, float alpha, const float u[2])
  * eta is clamped to [1/3, 3] for the lookup. */
 float ggx_albedo_mirror(float cos_o, float alpha);
 float ggx_albedo_dielectric(float cos_o, float alpha, float eta);
+/* The clear coat's (bsdf_coat_fresnel, reflection only) albedo at cos_o,
+ * and its average over cosine-weighted directions, 2 int E(mu) mu dmu:
+ * what the coat reflects of light arriving evenly from every side. */
+float ggx_albedo_coat(float cos_o, float alpha);
+float ggx_albedo_coat_average(float alpha);
 
 #endif

@@ -25,6 +25,21 @@ float ggx_albedo_mirror(float cos_o, float alpha)
     return lookup(ggx_mirror_albedo, cos_o, alpha);
 }
 
+float ggx_albedo_coat(float cos_o, float alpha)
+{
+    return lookup(ggx_coat_albedo, cos_o, alpha);
+}
+
+float ggx_albedo_coat_average(float alpha)
+{
+    float y = f_clamp01(sqrtf(alpha)) * (GGX_ROUGH_N - 1);
+    int yi = (int)y;
+    if (yi > GGX_ROUGH_N - 2)
+        yi = GGX_ROUGH_N - 2;
+    float fy = y - (float)yi;
+    return ggx_coat_average[yi] + fy * (ggx_coat_average[yi + 1] - ggx_coat_average[yi]);
+}
+
 float ggx_albedo_dielectric(float cos_o, float alpha, float eta)
 {
     int side = eta < 1.0f;

@@ -60,20 +60,22 @@ static vec3f nee_rough(const rs_object *m, const shading_frame *frame, vec3f n, 
 {
     if ((f3_dot(n, wi) > 0.0f) != (f3_dot(frame->n, wi) > 0.0f))
         return f3_splat(0.0f);
-    float fcos[LOBE_COUNT], pdf[LOBE_COUNT], sum = 0.0f, metal = 0.0f;
+    float fcos[LOBE_COUNT], pdf[LOBE_COUNT], sum = 0.0f, metal = 0.0f, coat = 0.0f;
     bsdf_eval_rough(m, frame, wo, wi, eta_i, eta_t, fcos, pdf);
     for (int k = 0; k < LOBE_COUNT; k++)
         if (fcos[k] > 0.0f) {
             float v = fcos[k] * (light_delta ? 1.0f / p_light : power_heuristic_over(p_light, pdf[k]));
             if (k == LOBE_METALLIC)
                 metal = v;
+            else if (k == LOBE_DIFFUSE) /* the coat: white */
+                coat = v;
             else
                 sum += v;
         }
     if (metal == 0.0f)
-        return f3_scale(m->color, sum);
+        return f3_add(f3_scale(m->color, sum), f3_splat(coat));
     vec3f tint = bsdf_metal_tint(m, m->color, f3_dot(frame->n, wo));
-    return f3_mul(m->color, f3_add(f3_splat(sum), f3_scale(tint, metal)));
+    return f3_add(f3_mul(m->color, f3_add(f3_splat(sum), f3_scale(tint, metal))), f3_splat(coat));
 }
 
 path_pixel path_pixel_make(uint32_t key)
@@ -244,8 +246,8 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             vec3f fcos = f3_splat(0.0f), rough = f3_splat(0.0f);
             int below = f3_dot(n, ls.wi) <= 0.0f;
             if (!bent || !below)
-                fcos = bsdf_eval_diffuse(m, ns, ls.wi, &bsdf_pdf);
-            if (m->rough)
+                fcos = bsdf_eval_base(m, ns, ls.wi, f3_dot(ns, wo), &bsdf_pdf);
+            if (m->rough | m->coat)
                 rough = nee_rough(m, &frame, n, wo, ls.wi, eta_i, eta_t, ls.pdf, ls.delta);
             if (bsdf_pdf > 0.0f || !f3_is_black(rough)) {
                 n_rays++;
@@ -291,8 +293,8 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 vec3f fcos = f3_splat(0.0f), rough = f3_splat(0.0f);
                 int below = f3_dot(n, wi) <= 0.0f;
                 if (!bent || !below)
-                    fcos = bsdf_eval_diffuse(m, ns, wi, &bsdf_pdf);
-                if (m->rough)
+                    fcos = bsdf_eval_base(m, ns, wi, f3_dot(ns, wo), &bsdf_pdf);
+                if (m->rough | m->coat)
                     rough = nee_rough(m, &frame, n, wo, wi, eta_i, eta_t, far_pdf, 0);
                 if (bsdf_pdf > 0.0f || !f3_is_black(rough)) {
                     n_rays++;

@@ -29,7 +29,8 @@ static void material_at(const rs_object *m, float u, float v, rs_object *out)
         int lobes = 0;
         for (int k = 0; k < LOBE_COUNT; k++)
             lobes += out->weight[k] > 0.0f;
-        out->lobe_choice = lobes > 1;
+        out->coat = (uint8_t)(out->specular > 0.0f && out->weight[LOBE_DIFFUSE] > 0.0f);
+        out->lobe_choice = lobes > 1 || out->coat;
     }
     if (mp->rough) {
         float r = mp->roughness * channel(texture_lookup_linear(mp->rough, u, v),

@@ -42,7 +42,10 @@ static void fill_object(rs_object *ro, const material *mat, vec3 emission, int i
         ro->weight[k] = (float)mat->weight[k];
         lobes += ro->weight[k] > 0.0f;
     }
-    ro->lobe_choice = lobes > 1;
+    ro->specular = (float)mat->specular;
+    ro->coat = (uint8_t)(ro->specular > 0.0f && ro->weight[LOBE_DIFFUSE] > 0.0f);
+    /* (A coat is a second choice under the diffuse lobe.) */
+    ro->lobe_choice = lobes > 1 || ro->coat;
     ro->color = v3_to_f3(mat->color);
     ro->ior = (float)mat->ior;
     ro->thin = (uint8_t)(mat->thin && mat->weight[LOBE_REFRACTIVE] > 0);

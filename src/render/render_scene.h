@@ -61,10 +61,13 @@ typedef struct rs_object {
     uint8_t rough;      /* a lobe is GGX (material/microfacet.h): alpha > 0
                            and a metallic, reflecting or non-pane
                            refractive weight */
+    uint8_t coat;       /* a clear coat lies over the diffuse lobe:
+                           specular > 0 and a diffuse weight (bsdf.h) */
     uint8_t alpha_mode; /* ALPHA_MASK or ALPHA_BLEND: the surface covers a
                            share of each hit (rs_coverage_at, prim.h) and
                            light passes by the rest; ALPHA_OPAQUE: all */
     float alpha;        /* GGX alpha = roughness^2 (0: smooth lobes) */
+    float specular;     /* the coat's Fresnel scale (material.specular) */
     float alpha_cutoff; /* MASK: coverage below it is a hole */
     float coverage;     /* coverage factor (times the texture's alpha) */
     vec3f tint;         /* a pane's transmission colour */

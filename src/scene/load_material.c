@@ -1,5 +1,6 @@
 /* Materials: the four lobe weights, the albedo, the refractive index,
- * the roughness of the non-diffuse lobes, whether the refractive lobe is
+ * the roughness of the non-diffuse lobes, the clear coat over the diffuse
+ * one, whether the refractive lobe is
  * a thin pane, and the coverage. */
 #include "scene/scene_reader.h"
 
@@ -41,7 +42,8 @@ static zt_status load_character(load_ctx *ctx, jref ref, double *weight)
 zt_status load_material(load_ctx *ctx, jref ref, material *out)
 {
     static const char *const keys[] = {
-        "character", "color", "coverage", "refractiveindex", "roughness", "thin", NULL
+        "character", "color", "coverage", "refractiveindex", "roughness", "specular", "thin",
+        NULL
     };
     material m = material_default();
     if (load_object(ctx, ref, "material") ||
@@ -65,6 +67,18 @@ zt_status load_material(load_ctx *ctx, jref ref, material *out)
             return ZT_ERR_PARSE;
         if (!(m.roughness >= 0 && m.roughness <= 1))
             return load_fail(ctx, rough, "roughness must be in [0, 1], not %g", m.roughness);
+    }
+    /* A clear coat over the diffuse lobe (glTF's dielectric layer over
+     * non-metals at 1): its Fresnel's scale. */
+    jref spec = jref_member(ref.value, "specular");
+    if (spec.value) {
+        if (load_number(ctx, spec, &m.specular))
+            return ZT_ERR_PARSE;
+        if (!(m.specular >= 0 && m.specular <= 1))
+            return load_fail(ctx, spec, "specular must be in [0, 1], not %g", m.specular);
+        if (m.specular > 0 && m.weight[LOBE_DIFFUSE] <= 0)
+            return load_fail(ctx, spec,
+                             "specular is a coat over the diffuse lobe, but its weight is 0");
     }
     jref thin = jref_member(ref.value, "thin");
     if (thin.value) {

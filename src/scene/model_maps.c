@@ -92,11 +92,11 @@ static void count_unused(const struct aiMaterial *am, int gltf, mesh *m, int bum
                                  aiGetMaterialTextureCount(am, aiTextureType_AMBIENT_OCCLUSION);
     double v;
     struct aiColor4D c;
-    /* glTF's KHR_materials_specular, a specular texture (MTL's map_Ks,
-     * glTF's specular-glossiness), MTL's Ks. */
+    /* A specular texture (MTL's map_Ks, glTF's specular-glossiness or
+     * KHR_materials_specular's), MTL's Ks.  (glTF's specular factor is
+     * read: the coat's scale.) */
     has[MESH_UNUSED_SPECULAR] =
         aiGetMaterialTextureCount(am, aiTextureType_SPECULAR) ||
-        (gltf && model_material_float(am, AI_MATKEY_SPECULAR_FACTOR, &v)) ||
         (!gltf && aiGetMaterialColor(am, AI_MATKEY_COLOR_SPECULAR, &c) == aiReturn_SUCCESS &&
          (c.r > 0 || c.g > 0 || c.b > 0));
     has[MESH_UNUSED_CLEARCOAT] = (model_material_float(am, AI_MATKEY_CLEARCOAT_FACTOR, &v) && v > 0) ||

@@ -295,6 +295,14 @@ static void map_material(const struct aiMaterial *am, int gltf, int obj, double 
     else if (obj && model_material_float(am, AI_MATKEY_SHININESS, &v) && v >= 0.0)
         s->roughness = clamp01(pow(2.0 / (v + 2.0), 0.25));
     s->mat.roughness = s->roughness;
+    /* glTF's non-metals have a dielectric layer (F0 = 0.04 at the
+     * material's roughness) over the base colour: the coat, scaled by
+     * KHR_materials_specular's factor. */
+    if (gltf) {
+        s->mat.specular = 1.0;
+        if (model_material_float(am, AI_MATKEY_SPECULAR_FACTOR, &v))
+            s->mat.specular = clamp01(v);
+    }
     s->texture = s->emissive_texture = -1;
     s->rough_map.texture = s->metal_map.texture = s->normal_texture = -1;
     s->normal_scale = 1.0;

@@ -24,6 +24,9 @@ typedef struct material {
     vec3 tint;                 /* a pane's transmission colour */
     double roughness;          /* of the metallic, reflecting and refractive
                                   lobes, in [0,1]; 0 smooth (GGX above) */
+    double specular;           /* a clear coat over the diffuse lobe, in
+                                  [0,1]: its Fresnel's scale (F0 = 0.04 x
+                                  it), at the roughness; 0 none */
     int alpha_mode;            /* ALPHA_OPAQUE (alpha ignored), ALPHA_MASK or
                                   ALPHA_BLEND: glTF's alphaMode */
     double alpha_cutoff;       /* MASK: coverage below it is a hole, in [0,1] */

@@ -27,6 +27,8 @@ uint64_t scene_hash(const zt_scene *sc)
         }
         if (o->mat.roughness > 0)
             fnv_f64(&h, o->mat.roughness);
+        if (o->mat.specular > 0) /* (only then, as above) */
+            fnv_f64(&h, o->mat.specular);
         if (o->mat.alpha_mode != ALPHA_OPAQUE) { /* (only then, as above) */
             fnv_i32(&h, o->mat.alpha_mode);
             fnv_f64(&h, o->mat.alpha_cutoff);
@@ -83,6 +85,10 @@ uint64_t scene_hash(const zt_scene *sc)
              * before roughness was read stay valid.) */
             if (sl->mat.roughness > 0 && sl->mat.weight[LOBE_DIFFUSE] < 1)
                 fnv_f64(&h, sl->mat.roughness);
+            if (sl->mat.specular > 0) { /* the coat's roughness too */
+                fnv_f64(&h, sl->mat.specular);
+                fnv_f64(&h, sl->mat.roughness);
+            }
             fnv_v3(&h, sl->emission);
             fnv_i32(&h, sl->texture);
             if (sl->mat.alpha_mode != ALPHA_OPAQUE) {

@@ -358,6 +358,8 @@ typedef struct zone_rough_at {
     int entering;       /* whether the ray enters it */
     const int *media;   /* the glass the ray is in (media.h) */
     int media_count;
+    float budget;       /* the share of a camera sample's directions to
+                           take (0: all of them) */
 } zone_rough_at;
 
 /* The radiance that the rough lobes of s->m among `lobes` (a mask of
@@ -367,6 +369,13 @@ typedef struct zone_rough_at {
  * weighed by multiple importance sampling (phase_two/rough.c). */
 vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, int lo, int hi,
                          int flags);
+/* The light of levels lo..hi that a coat (bsdf.h) on a ray's way sends
+ * back along it: one of its directions, taken with probability s E(cos_o)
+ * (its share of evenly arriving light) by a hash of the point and the
+ * arriving direction, and weighed by its inverse: unbiased, for a ray in
+ * about s E(cos_o) (phase_two/rough.c).  s->color is ignored (white). */
+vec3 zone_coat_on_the_way(zone_trace *t, const zone_rough_at *s, int lo, int hi, int flags);
+
 /* One direction *wi from s's rough lobes, chosen by a hash of the point
  * and the arriving direction, and *value, their f cos over its density
  * (the colour apart): how a caustic photon goes on.  0: none. */

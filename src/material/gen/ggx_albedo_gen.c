@@ -26,7 +26,9 @@ static vec3f reflect_about(vec3f wo, vec3f h)
     return f3_sub(f3_scale(h, 2.0f * f3_dot(wo, h)), wo);
 }
 
-/* eta 0 means the mirror (F = 1, reflection only). */
+/* eta 0 means the mirror (F = 1, reflection only); COAT the clear layer
+ * over a diffuse base (Schlick's F with F0 = 0.04, reflection only). */
+#define COAT (-1.0f)
 static double albedo(float cos_o, float alpha, float eta)
 {
     vec3f wo = f3(sqrtf(f_max0(1.0f - cos_o * cos_o)), 0.0f, cos_o);
@@ -35,13 +37,15 @@ static double albedo(float cos_o, float alpha, float eta)
         float u[2] = {((float)i + 0.5f) / TABLE_SAMPLES, radical_inverse2(i)};
         vec3f h = ggx_sample_vndf(wo, alpha, u);
         float c = f3_dot(wo, h);
-        float f = eta > 0.0f ? bsdf_fresnel_dielectric(c, 1.0f, eta) : 1.0f;
+        float f = eta > 0.0f    ? bsdf_fresnel_dielectric(c, 1.0f, eta)
+                  : eta == COAT ? bsdf_coat_fresnel(c)
+                                : 1.0f;
         float g = 1.0f / ggx_g1(wo, alpha);
         vec3f wr = reflect_about(wo, h);
         if (wr.z > 0.0f)
             sum += f * ggx_g2(wo, wr, alpha) * g;
         vec3f wt;
-        if (f < 1.0f && bsdf_refract(wo, h, 1.0f / eta, &wt) && wt.z < 0.0f)
+        if (eta > 0.0f && f < 1.0f && bsdf_refract(wo, h, 1.0f / eta, &wt) && wt.z < 0.0f)
             sum += (1.0f - f) * ggx_g2(wo, wt, alpha) * g;
     }
     return sum / TABLE_SAMPLES;
@@ -62,6 +66,21 @@ int main(void)
     for (int ri = 0; ri < GGX_ROUGH_N; ri++)
         row(ri, 0.0f);
     printf("};\n");
+    printf("static const float ggx_coat_albedo[GGX_ROUGH_N][GGX_COS_N] = {\n");
+    for (int ri = 0; ri < GGX_ROUGH_N; ri++)
+        row(ri, COAT);
+    printf("};\n");
+    /* The coat's albedo averaged over cosine-weighted directions,
+     * 2 int E(mu) mu dmu, by the midpoint rule on a finer grid. */
+    printf("static const float ggx_coat_average[GGX_ROUGH_N] = {");
+    for (int ri = 0; ri < GGX_ROUGH_N; ri++) {
+        double sum = 0.0;
+        for (int k = 0; k < 64; k++) {
+            float mu = ((float)k + 0.5f) / 64.0f;
+            sum += albedo(mu, ggx_grid_alpha(ri), COAT) * mu;
+        }
+        printf("%.6ff%s", 2.0 * sum / 64.0, ri + 1 < GGX_ROUGH_N ? ", " : "};\n");
+    }
     printf("static const float ggx_dielectric_albedo[2][GGX_ETA_N][GGX_ROUGH_N][GGX_COS_N] = {\n");
     for (int side = 0; side < 2; side++) {
         printf("  {\n");

@@ -160,7 +160,7 @@ static void rough_on(tracer *t, const rs_part *p, int part, const rs_object *m,
         rs_shade_at(rs, part, p, m, xf, nf, &own);
     const rs_shade *sh = known ? known : &own;
     zone_rough_at at = {m,     part,  xf,       nf,         sh->ns, f3_to_v3(sh->albedo), d,
-                        eta_i, eta_t, p->object, entering, media, media_count};
+                        eta_i, eta_t, p->object, entering, media, media_count, 0.0f};
     vec3f wi, value;
     if (!zone_rough_scatter(&at, &wi, &value))
         return;

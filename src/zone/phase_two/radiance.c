@@ -142,7 +142,15 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
             /* The maps of the remaining levels, read at once. */
             e = zone_map_read_levels(t->f, rs, l - 1, hi - 1, h.part, back, x, e);
         }
-        out = v3_add(out, v3_scale(v3_mul(color, e), m->weight[LOBE_DIFFUSE] / 3.14159265358979));
+        /* Under a coat (bsdf.h) the base keeps 1 - s E(cos_o). */
+        double keep = 1.0 - bsdf_coat_albedo(m, -f3_dot(sh.ns, d));
+        out = v3_add(out, v3_scale(v3_mul(color, e),
+                                   keep * m->weight[LOBE_DIFFUSE] / 3.14159265358979));
+    }
+    if (m->coat && hi >= 1 && !(flags & ZR_SKIP_DIFFUSE)) {
+        zone_rough_at at = {m, h.part, xf, nf, sh.ns, color, d, 1.0f, 1.0f, p->object, 0,
+                            media, media_count, 0.0f};
+        out = v3_add(out, zone_coat_on_the_way(t, &at, lo - 1, hi - 1, flags));
     }
 
     /* Smooth lobes here; rough ones (m->rough: all but a pane's) below. */
@@ -201,7 +209,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
     }
     if (m->rough && hi >= 1) {
         zone_rough_at at = {m, h.part, xf, back ? f3_neg(ngf) : ngf, sh.ns, color, d, 1.0f,
-                            1.0f, p->object, 0, media, media_count};
+                            1.0f, p->object, 0, media, media_count, 0.0f};
         at.entering = media_indices(rs, media, media_count, p->object, m, &at.eta_i, &at.eta_t);
         out = v3_add(out, zone_rough_radiance(t, &at, ~0u, lo - 1, hi - 1, flags));
     }

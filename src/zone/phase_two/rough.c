@@ -196,10 +196,19 @@ static vec3 light_samples(zone_trace *t, const zone_rough_at *s, const shading_f
     return out;
 }
 
-/* The rough lobes among `lobes` that m has, and the sum of their weights. */
-static unsigned rough_lobes(const rs_object *m, unsigned lobes, float *weight_sum)
+/* The rough lobes among `lobes` that m has, and the sum of their weights
+ * (the densities' normaliser).  The coat (bsdf.h) is in the diffuse
+ * lobe's place, and only when asked for alone (its light is white, the
+ * others' tinted): its weight is the diffuse one's times its choice, s
+ * E(cos_o). */
+static unsigned rough_lobes(const rs_object *m, unsigned lobes, float cos_o, float *weight_sum)
 {
     *weight_sum = 0.0f;
+    if (lobes == 1u << LOBE_DIFFUSE) {
+        if (m->coat)
+            *weight_sum = m->weight[LOBE_DIFFUSE] * bsdf_coat_albedo(m, cos_o);
+        return *weight_sum > 0.0f ? lobes : 0u;
+    }
     for (int k = 0; k < LOBE_COUNT; k++) {
         if (!bsdf_lobe_rough(m, k))
             lobes &= ~(1u << k);
@@ -242,7 +251,7 @@ static int scatter(const zone_rough_at *s, const shading_frame *fr, unsigned lob
 int zone_rough_scatter(const zone_rough_at *s, vec3f *wi, vec3f *value)
 {
     float weight_sum, pdf;
-    unsigned lobes = rough_lobes(s->m, ~0u, &weight_sum);
+    unsigned lobes = rough_lobes(s->m, ~0u, 1.0f, &weight_sum);
     if (!(weight_sum > 0.0f))
         return 0;
     shading_frame fr;
@@ -313,7 +322,7 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
     const rs_object *m = s->m;
     const rscene *rs = &t->r->rs;
     float weight_sum;
-    lobes = rough_lobes(m, lobes, &weight_sum);
+    lobes = rough_lobes(m, lobes, -f3_dot(s->ns, s->d), &weight_sum);
     if (!(weight_sum > 0.0f) || hi < 0 || lo > hi)
         return v3(0, 0, 0);
     if (lo < 0)
@@ -324,7 +333,9 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
     /* The directions: the camera sample's share of its pixel's, or one
      * from a point of the sequence a hash of where it is picks. */
     zone_gather_slot slot = t->gather;
-    double share = t->sample_share;
+    double own_share = t->sample_share;
+    /* (A coat takes its share of them: terms.c.) */
+    double share = own_share * (s->budget > 0.0f ? s->budget : 1.0f);
     const zone_quality *q = &t->f->q;
     int camera = share > 0.0 && slot.samples > 0;
     int k_max = camera ? sample_count(q->rough_pixel, share, q->rough_sample) : 1;
@@ -378,8 +389,29 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
     t->gather = slot;
     t->rough_nested = save_nested;
     t->rough_j = save_j;
-    t->sample_share = share;
+    t->sample_share = own_share;
     t->mis_pdf = 0.0f;
     t->light_split = save_split;
     return v3_scale(v3_mul(s->color, sum), 1.0 / k_max);
+}
+
+/* An irrational unrelated to the sequence's (the plastic number's
+ * reciprocal): the coat's roulette on a ray's way. */
+#define PLASTIC_1 0.75487766624669276005
+
+vec3 zone_coat_on_the_way(zone_trace *t, const zone_rough_at *s, int lo, int hi, int flags)
+{
+    float a = bsdf_coat_albedo(s->m, -f3_dot(s->ns, s->d));
+    if (!(a > 0.0f) || hi < 0 || lo > hi)
+        return v3(0, 0, 0);
+    double u = hashed_index(s->x, s->d) * PLASTIC_1 + 0.25;
+    if (u - floor(u) >= a)
+        return v3(0, 0, 0);
+    zone_rough_at white = *s;
+    white.color = v3(1, 1, 1);
+    /* No photons leave by coats: the light they reflect of the lights is
+     * read here, in Phase One's gathers too. */
+    return v3_scale(zone_rough_radiance(t, &white, 1u << LOBE_DIFFUSE, lo, hi,
+                                        flags & ~ZR_NO_CAUSTIC),
+                    1.0 / a);
 }

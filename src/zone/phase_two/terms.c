@@ -143,6 +143,28 @@ void p2_surface_of(const rscene *rs, const p2_sample *s, p2_surface *sf)
     sf->color = f3_to_v3(sh->albedo);
 }
 
+/* A coated diffuse surface's light of level l at a camera sample, from
+ * its base's (diffuse: colour x irradiance x weight / pi): the base keeps
+ * 1 - s E(cos_o) of it (bsdf.h), and the coat's reflection of level l - 1
+ * is read along the rough lobes' directions (rough.c), a share of the
+ * pixel's as large as the coat's share of what the surface returns (a
+ * coat over a white base seen head-on is a twentieth of it). */
+static vec3 coated(zone_trace *t, const p2_sample *s, const p2_surface *sf, int l, vec3 diffuse)
+{
+    const rs_object *m = sf->m;
+    vec3f ns = v3_to_f3(sf->n);
+    float a = bsdf_coat_albedo(m, -f3_dot(ns, s->d));
+    if (!(a > 0.0f))
+        return diffuse;
+    float base = (1.0f - a) * f3_luminance(v3_to_f3(sf->color));
+    zone_rough_at at = {m,  s->part, sf->xf, sf->nf, ns, v3(1, 1, 1), s->d, 1.0f, 1.0f,
+                        sf->p->object, 1, NULL, 0, a / (a + base)};
+    /* What its directions meet is read from the forest, without the exact
+     * direct light there: the coat is a small share, and blurs it. */
+    return v3_add(v3_scale(diffuse, 1.0 - a),
+                  zone_rough_radiance(t, &at, 1u << LOBE_DIFFUSE, l - 1, l - 1, 0));
+}
+
 /* Level 1 diffuse light: every light exactly, and the sky. */
 static vec3 direct_value(zone_trace *t, const p2_sample *s)
 {
@@ -151,7 +173,8 @@ static vec3 direct_value(zone_trace *t, const p2_sample *s)
     vec3 e = zone_lights_at(t, s->part, sf.x, sf.n);
     if (t->f->sky)
         e = v3_add(e, zone_sky_irradiance(t, sf.x, sf.n));
-    return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
+    vec3 v = v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
+    return sf.m->coat ? coated(t, s, &sf, 1, v) : v;
 }
 
 /* Level l >= 2 diffuse light from the surface's nodes E_{l-1}, or on a
@@ -167,7 +190,8 @@ static vec3 map_value(zone_trace *t, const p2_term *term, const p2_sample *s)
     if (t->f->caustic)
         e = v3_add(e, zone_caustic_read(t, term->level - 1, term->level - 1, s->part, sf.back,
                                         sf.x, f3_to_v3(sf.nf)));
-    return v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
+    vec3 v = v3_scale(v3_mul(sf.color, e), sf.m->weight[LOBE_DIFFUSE] / 3.14159265358979);
+    return sf.m->coat ? coated(t, s, &sf, term->level, v) : v;
 }
 
 /* A specular lobe at level l: its share of the level l-1 radiance along
@@ -189,7 +213,7 @@ static vec3 specular_value(zone_trace *t, const p2_term *term, const p2_sample *
                                              : LOBE_REFRACTIVE;
     if (bsdf_lobe_rough(m, lobe)) {
         zone_rough_at at = {m,     s->part, sf.xf, sf.nf, ns, sf.color, d, eta_i, eta_t,
-                            sf.p->object, 1, NULL, 0};
+                            sf.p->object, 1, NULL, 0, 0.0f};
         return zone_rough_radiance(t, &at, 1u << lobe, l - 1, l - 1, ZR_EXACT_DIRECT);
     }
     switch (term->kind) {

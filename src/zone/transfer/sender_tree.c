@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "material/bsdf.h"
 #include "material/texture.h"
 #include "render/prim.h"
 #include "util/select_nth.h"
@@ -49,6 +50,13 @@ static void element_albedo(const rscene *rs, int prim, const vec3 q[4], int corn
             if (o->alpha_mode)
                 k *= rs_coverage_mean(o, uv[0], uv[1], uv[2], 4);
         }
+    }
+    /* A coat (bsdf.h) sends what it reflects of light arriving evenly,
+     * s E_avg, as the base does: spread as a diffuse surface's, in the
+     * mean over directions; the base keeps the rest. */
+    if (o->coat) {
+        float a = o->specular * ggx_albedo_coat_average(bsdf_coat_alpha(o));
+        col = f3_add(f3_scale(col, 1.0f - a), f3_splat(a));
     }
     out[0] = col.x * k;
     out[1] = col.y * k;
