@@ -6,7 +6,7 @@ Python (json, struct, zlib): a test model for model files' materials.
                                    [--size N] [--tangents] [--base-size N] [--color R G B]
                                    [--no-normal] [--no-mr] [--metal-right M]
                                    [--alpha-mode MODE] [--alpha A] [--alpha-cutoff C]
-                                   [--stripes]
+                                   [--stripes] [--specular F]
 
 The model is one square of side 2 in the plane y = 0, centred on the origin, its front face (and
 normal) up, +x along the texture's u and -z along its v (so the image's left half is x < 0 and
@@ -30,6 +30,8 @@ whose size differs from the maps'.  With --tangents the vertices carry TANGENT (
 without, the reader makes its own.  --no-normal leaves the normal texture out, --no-mr the
 metallic-roughness one (the factors then give metallic --metal and roughness --rough).
 
+--specular F writes KHR_materials_specular with specularFactor F (0: no layer over the
+non-metal's base, so that its light is the Lambertian formula's).
 --alpha-mode writes the material's alphaMode (OPAQUE, MASK or BLEND), --alpha the base colour
 factor's alpha (default 1), --alpha-cutoff its alphaCutoff as given (even outside [0, 1], or nan,
 which json writes as the non-standard NaN: for tests of bad input).  --stripes writes a white
@@ -79,14 +81,15 @@ def halves(n, left, right):
 def main(argv):
     args = {"rough": 1.0, "metal": 1.0, "tilt": 0.0, "scale": 1.0, "size": 4, "tangents": False,
             "base_size": 0, "color": [1.0, 1.0, 1.0], "normal": True, "mr": True,
-            "alpha_mode": None, "alpha": 1.0, "alpha_cutoff": None, "stripes": False}
+            "alpha_mode": None, "alpha": 1.0, "alpha_cutoff": None, "stripes": False,
+            "specular": None}
     out = None
     i = 0
     try:
         while i < len(argv):
             a = argv[i]
             if a in ("--rough", "--metal", "--tilt", "--scale", "--metal-right", "--alpha",
-                     "--alpha-cutoff"):
+                     "--alpha-cutoff", "--specular"):
                 args[a[2:].replace("-", "_")] = float(argv[i + 1])
                 i += 2
             elif a in ("--size", "--base-size"):
@@ -167,6 +170,8 @@ def main(argv):
     else:
         pbr["metallicFactor"], pbr["roughnessFactor"] = args["metal"], args["rough"]
     material = {"name": "pbr", "pbrMetallicRoughness": pbr}
+    if args["specular"] is not None:
+        material["extensions"] = {"KHR_materials_specular": {"specularFactor": args["specular"]}}
     if args["normal"]:
         material["normalTexture"] = {"index": len(images), "scale": args["scale"]}
         images.append({"uri": stem + "_n.png"})
@@ -200,6 +205,8 @@ def main(argv):
         "bufferViews": views,
         "accessors": accessors,
     }
+    if args["specular"] is not None:
+        doc["extensionsUsed"] = ["KHR_materials_specular"]
     with open(out, "w") as f:
         json.dump(doc, f, indent=1)
         f.write("\n")

@@ -34,10 +34,12 @@ static json_t *parse(const char *text, size_t length)
     return json_loadb(text, length, 0, NULL);
 }
 
-void gltf_emissive_strengths(const char *path, int count, double *strength)
+/* The number `key` of extension `ext` of each of the first `count`
+ * materials into out[] where `ok` accepts it (out[] keeps what it had
+ * elsewhere). */
+static void material_numbers(const char *path, int count, const char *ext, const char *key,
+                             int (*ok)(double *), double *out)
 {
-    for (int i = 0; i < count; i++)
-        strength[i] = 1.0;
     char *text = NULL;
     size_t length = 0;
     zt_error err;
@@ -48,12 +50,41 @@ void gltf_emissive_strengths(const char *path, int count, double *strength)
     free(text);
     json_t *materials = json_object_get(root, "materials");
     for (int i = 0; i < count && (size_t)i < json_array_size(materials); i++) {
-        json_t *ext = json_object_get(json_object_get(json_array_get(materials, (size_t)i),
-                                                      "extensions"),
-                                      "KHR_materials_emissive_strength");
-        json_t *v = json_object_get(ext, "emissiveStrength");
-        if (json_is_number(v) && isfinite(json_number_value(v)) && json_number_value(v) >= 0.0)
-            strength[i] = json_number_value(v);
+        json_t *e = json_object_get(json_object_get(json_array_get(materials, (size_t)i),
+                                                    "extensions"),
+                                    ext);
+        json_t *v = json_object_get(e, key);
+        double x = json_is_number(v) ? json_number_value(v) : NAN;
+        if (json_is_number(v) && ok(&x))
+            out[i] = x;
     }
     json_decref(root);
+}
+
+static int strength_ok(double *x)
+{
+    return isfinite(*x) && *x >= 0.0;
+}
+
+static int factor_ok(double *x)
+{
+    if (!isfinite(*x))
+        return 0;
+    *x = *x < 0.0 ? 0.0 : *x > 1.0 ? 1.0 : *x;
+    return 1;
+}
+
+void gltf_emissive_strengths(const char *path, int count, double *strength)
+{
+    for (int i = 0; i < count; i++)
+        strength[i] = 1.0;
+    material_numbers(path, count, "KHR_materials_emissive_strength", "emissiveStrength",
+                     strength_ok, strength);
+}
+
+void gltf_specular_factors(const char *path, int count, double *factor)
+{
+    for (int i = 0; i < count; i++)
+        factor[i] = 1.0;
+    material_numbers(path, count, "KHR_materials_specular", "specularFactor", factor_ok, factor);
 }

@@ -1,6 +1,7 @@
 /* What a glTF file says that Assimp 5.2 does not pass on, read from the
  * file's JSON: KHR_materials_emissive_strength (newer Assimp gives it as
- * AI_MATKEY_EMISSIVE_INTENSITY, which model_materials.c reads first).
+ * AI_MATKEY_EMISSIVE_INTENSITY, which model_materials.c reads first) and
+ * KHR_materials_specular's specularFactor.
  * (Assimp 5.2 does give a material without an emissiveFactor glTF's
  * default, black, also when it has an emissive texture.) */
 #ifndef ZT_SCENE_GLTF_EXTENSIONS_H
@@ -13,5 +14,10 @@
  * (Assimp has read it already, so that is only short of memory) every
  * strength is 1. */
 void gltf_emissive_strengths(const char *path, int count, double *strength);
+
+/* The same for each material's KHR_materials_specular specularFactor
+ * (the layer over non-metals; 1 where a material has none, clamped to
+ * [0, 1], 1 where it is not a number). */
+void gltf_specular_factors(const char *path, int count, double *factor);
 
 #endif

@@ -2,9 +2,9 @@
  *
  * glTF's metallic-roughness model and OBJ's MTL both reach us through
  * Assimp's material keys.  The mapping keeps what the material model can
- * show: base colour, metal, glass, roughness, emission.  glTF's thin
- * dielectric specular layer over non-metals (a 4% Fresnel reflection) has
- * no lobe here. */
+ * show: base colour, metal, glass, roughness, emission, and glTF's thin
+ * dielectric layer over non-metals (a 4% Fresnel reflection head-on) as
+ * the diffuse lobe's clear coat. */
 #define _POSIX_C_SOURCE 200809L
 #include "scene/model_materials.h"
 
@@ -229,7 +229,7 @@ static int material_texture(model_textures *tx, const struct aiMaterial *am, zt_
  * as read from the file (gltf_extensions.h; 1 for other formats), for an
  * Assimp that does not give it. */
 static void map_material(const struct aiMaterial *am, int gltf, int obj, double strength,
-                         mesh_slot *s)
+                         double specular, mesh_slot *s)
 {
     memset(s, 0, sizeof *s);
     s->mat.alpha_cutoff = 0.5;
@@ -297,12 +297,9 @@ static void map_material(const struct aiMaterial *am, int gltf, int obj, double 
     s->mat.roughness = s->roughness;
     /* glTF's non-metals have a dielectric layer (F0 = 0.04 at the
      * material's roughness) over the base colour: the coat, scaled by
-     * KHR_materials_specular's factor. */
-    if (gltf) {
-        s->mat.specular = 1.0;
-        if (model_material_float(am, AI_MATKEY_SPECULAR_FACTOR, &v))
-            s->mat.specular = clamp01(v);
-    }
+     * KHR_materials_specular's factor (read from the file). */
+    if (gltf)
+        s->mat.specular = specular;
     s->texture = s->emissive_texture = -1;
     s->rough_map.texture = s->metal_map.texture = s->normal_texture = -1;
     s->normal_scale = 1.0;
@@ -399,22 +396,25 @@ zt_status model_materials(const struct aiScene *sc, const char *path,
     /* Assimp 5.2 drops KHR_materials_emissive_strength: read from the
      * file, by material index (Assimp keeps glTF's order; its default
      * material comes after). */
-    double *strength = malloc(((size_t)sc->mNumMaterials + 1) * sizeof *strength);
+    double *strength = malloc(2 * ((size_t)sc->mNumMaterials + 1) * sizeof *strength);
+    double *specular = strength ? strength + sc->mNumMaterials + 1 : NULL;
     if (!strength) {
         free(names);
         return zt_fail(err, ZT_ERR_MEMORY, "%s: out of memory", path);
     }
     for (unsigned i = 0; i < sc->mNumMaterials; i++)
-        strength[i] = 1.0;
-    if (gltf)
+        strength[i] = specular[i] = 1.0;
+    if (gltf) {
         gltf_emissive_strengths(path, (int)sc->mNumMaterials, strength);
+        gltf_specular_factors(path, (int)sc->mNumMaterials, specular);
+    }
     zt_status st = ZT_OK;
     for (unsigned i = 0; i < sc->mNumMaterials && st == ZT_OK; i++) {
         int s = slot_of_material[i];
         if (s < 0 || s >= slot_count || !sc->mMaterials[i] ||
             invented_material(sc->mMaterials[i], no_materials))
             continue;
-        map_material(sc->mMaterials[i], gltf, obj, strength[i], &m->slots[s]);
+        map_material(sc->mMaterials[i], gltf, obj, strength[i], specular[i], &m->slots[s]);
         if (gltf)
             map_alpha(sc->mMaterials[i], m, &m->slots[s]);
         m->slots[s].texture = material_texture(&tx, sc->mMaterials[i], &st, err);

@@ -11,7 +11,7 @@ make="python3 $here/../../tools/make_pbr_gltf.py"
 out="$here/alpha"
 mkdir -p "$out"
 rm -f "$out"/*.gltf "$out"/*.bin "$out"/*.png
-plain="--metal 0 --rough 1 --no-normal --no-mr"
+plain="--metal 0 --rough 1 --no-normal --no-mr --specular 0"
 # A white diffuse square whose 8 stripes along u are alternately covered
 # (alpha 255) and holes (alpha 0): alphaMode MASK, the default cutoff.
 $make "$out/stripes.gltf" $plain --size 8 --stripes --alpha-mode MASK

@@ -16,7 +16,7 @@ $make "$out/rough.gltf" --rough 0.5 --metal 1 --size 8 --no-normal
 # A white diffuse surface whose normal map tilts the left half by 30
 # degrees toward +u: tangents made by the reader, then given by the file
 # (with a normal scale of 0.5).
-$make "$out/tilt.gltf" --metal 0 --rough 0 --tilt 30 --size 8
-$make "$out/tilt_tangents.gltf" --metal 0 --rough 0 --tilt 30 --size 8 --tangents --scale 0.5
+$make "$out/tilt.gltf" --metal 0 --rough 0 --tilt 30 --size 8 --specular 0
+$make "$out/tilt_tangents.gltf" --metal 0 --rough 0 --tilt 30 --size 8 --specular 0 --tangents --scale 0.5
 # Maps of 8 x 8 texels over a base texture of 16 x 16: left out.
-$make "$out/sizes.gltf" --metal 0 --rough 0 --tilt 30 --size 8 --base-size 16
+$make "$out/sizes.gltf" --metal 0 --rough 0 --tilt 30 --size 8 --specular 0 --base-size 16
