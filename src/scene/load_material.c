@@ -39,6 +39,21 @@ static zt_status load_character(load_ctx *ctx, jref ref, double *weight)
     return ZT_OK;
 }
 
+/* The optional member `key` of ref, a number in [0, 1], into *out (left
+ * as it is when absent); *present says whether it was there. */
+static zt_status load_unit_member(load_ctx *ctx, jref ref, const char *key, double *out,
+                                  jref *present)
+{
+    *present = jref_member(ref.value, key);
+    if (!present->value)
+        return ZT_OK;
+    if (load_number(ctx, *present, out))
+        return ZT_ERR_PARSE;
+    if (!(*out >= 0 && *out <= 1))
+        return load_fail(ctx, *present, "%s must be in [0, 1], not %g", key, *out);
+    return ZT_OK;
+}
+
 zt_status load_material(load_ctx *ctx, jref ref, material *out)
 {
     static const char *const keys[] = {
@@ -61,25 +76,16 @@ zt_status load_material(load_ctx *ctx, jref ref, material *out)
             return load_fail(ctx, ior, "refractiveindex must be positive, not %g",
                              m.ior);
     }
-    jref rough = jref_member(ref.value, "roughness");
-    if (rough.value) {
-        if (load_number(ctx, rough, &m.roughness))
-            return ZT_ERR_PARSE;
-        if (!(m.roughness >= 0 && m.roughness <= 1))
-            return load_fail(ctx, rough, "roughness must be in [0, 1], not %g", m.roughness);
-    }
+    jref rough, spec, cover;
+    if (load_unit_member(ctx, ref, "roughness", &m.roughness, &rough))
+        return ZT_ERR_PARSE;
     /* A clear coat over the diffuse lobe (glTF's dielectric layer over
      * non-metals at 1): its Fresnel's scale. */
-    jref spec = jref_member(ref.value, "specular");
-    if (spec.value) {
-        if (load_number(ctx, spec, &m.specular))
-            return ZT_ERR_PARSE;
-        if (!(m.specular >= 0 && m.specular <= 1))
-            return load_fail(ctx, spec, "specular must be in [0, 1], not %g", m.specular);
-        if (m.specular > 0 && m.weight[LOBE_DIFFUSE] <= 0)
-            return load_fail(ctx, spec,
-                             "specular is a coat over the diffuse lobe, but its weight is 0");
-    }
+    if (load_unit_member(ctx, ref, "specular", &m.specular, &spec))
+        return ZT_ERR_PARSE;
+    if (m.specular > 0 && m.weight[LOBE_DIFFUSE] <= 0)
+        return load_fail(ctx, spec,
+                         "specular is a coat over the diffuse lobe, but its weight is 0");
     jref thin = jref_member(ref.value, "thin");
     if (thin.value) {
         if (load_bool(ctx, thin, &m.thin))
@@ -90,14 +96,10 @@ zt_status load_material(load_ctx *ctx, jref ref, material *out)
     }
     /* Coverage below 1: the surface is that share of itself, the rest
      * lets light through untouched (as a model's alphaMode BLEND). */
-    jref cover = jref_member(ref.value, "coverage");
-    if (cover.value) {
-        if (load_number(ctx, cover, &m.coverage))
-            return ZT_ERR_PARSE;
-        if (!(m.coverage >= 0 && m.coverage <= 1))
-            return load_fail(ctx, cover, "coverage must be in [0, 1], not %g", m.coverage);
+    if (load_unit_member(ctx, ref, "coverage", &m.coverage, &cover))
+        return ZT_ERR_PARSE;
+    if (cover.value)
         m.alpha_mode = m.coverage < 1 ? ALPHA_BLEND : ALPHA_OPAQUE;
-    }
     /* A hand-written pane is tinted by the material's colour, as the
      * smooth refractive lobe is. */
     m.tint = m.color;

@@ -143,7 +143,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
             e = zone_map_read_levels(t->f, rs, l - 1, hi - 1, h.part, back, x, e);
         }
         /* Under a coat (bsdf.h) the base keeps 1 - s E(cos_o). */
-        double keep = 1.0 - bsdf_coat_albedo(m, -f3_dot(sh.ns, d));
+        double keep = m->coat ? 1.0 - bsdf_coat_albedo(m, -f3_dot(sh.ns, d)) : 1.0;
         out = v3_add(out, v3_scale(v3_mul(color, e),
                                    keep * m->weight[LOBE_DIFFUSE] / 3.14159265358979));
     }
