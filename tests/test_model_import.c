@@ -390,21 +390,44 @@ static void test_invented_materials_grey(void **state)
 /* glTF's non-metals get the clear coat (the layer over their base), scaled
  * by KHR_materials_specular's specularFactor, which Assimp 5.2 does not
  * pass on and the importer reads from the file: 0 in tilt.gltf, none (1)
- * in rough.gltf.  An OBJ's material has none. */
+ * in rough.gltf.  An MTL's Ks is the coat's strength as Blender's OBJ
+ * importer reads it (Principled's Specular, F0 = 0.08 mean(Ks), so s = 2
+ * mean(Ks), at most 1); without Ks there is none.  Only a coloured Ks
+ * (whose tint the white coat leaves out) is reported unused. */
 static void test_gltf_specular_layer(void **state)
 {
     (void)state;
-    const char *models[3] = {ZT_SOURCE_DIR "/tests/data/pbr/tilt.gltf",
-                             ZT_SOURCE_DIR "/tests/data/pbr/rough.gltf", "white.obj"};
-    const double want[3] = {0.0, 1.0, 0.0};
-    test_write_file("white.mtl", "newmtl white\nKd 1 1 1\n");
-    test_write_file("white.obj", "mtllib white.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
-                                 "usemtl white\nf 1 2 3\n");
-    for (int k = 0; k < 3; k++) {
+    enum { N = 6 };
+    const char *models[N] = {ZT_SOURCE_DIR "/tests/data/pbr/tilt.gltf",
+                             ZT_SOURCE_DIR "/tests/data/pbr/rough.gltf",
+                             "white.obj", "ks_quarter.obj", "ks_one.obj", "ks_tinted.obj"};
+    const char *ks[N] = {NULL, NULL, NULL, "0.25 0.25 0.25", "1 1 1", "0.1 0.2 0.3"};
+    const double want[N] = {0.0, 1.0, 0.0, 0.5, 1.0, 0.4};
+    for (int k = 2; k < N; k++) {
+        char mtl[64], obj[64], text[256];
+        snprintf(mtl, sizeof mtl, "%.*s.mtl", (int)(strlen(models[k]) - 4), models[k]);
+        snprintf(obj, sizeof obj, "%s", models[k]);
+        snprintf(text, sizeof text, "newmtl white\nKd 1 1 1\n%s%s%s", ks[k] ? "Ks " : "",
+                 ks[k] ? ks[k] : "", ks[k] ? "\n" : "");
+        test_write_file(mtl, text);
+        snprintf(text, sizeof text,
+                 "mtllib %s\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl white\nf 1 2 3\n", mtl);
+        test_write_file(obj, text);
+    }
+    for (int k = 0; k < N; k++) {
         zt_scene *s = load_ok(write_scene("s_layer.json", models[k], ""));
         const mesh *m = only_mesh(s);
         for (int i = 0; i < m->slot_count; i++)
-            assert_true(m->slots[i].mat.specular == want[k]);
+            if (fabs(m->slots[i].mat.specular - want[k]) > 1e-6)
+                fail_msg("%s: specular %g, want %g", models[k], m->slots[i].mat.specular,
+                         want[k]);
+        if (k >= 2) {
+            zt_scene_info info;
+            zt_scene_get_info(s, &info);
+            int tinted = strstr(info.unused, "specular") != NULL;
+            if (tinted != (k == N - 1))
+                fail_msg("%s: unused \"%s\"", models[k], info.unused);
+        }
         zt_scene_release(s);
     }
 }

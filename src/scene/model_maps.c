@@ -93,12 +93,13 @@ static void count_unused(const struct aiMaterial *am, int gltf, mesh *m, int bum
     double v;
     struct aiColor4D c;
     /* A specular texture (MTL's map_Ks, glTF's specular-glossiness or
-     * KHR_materials_specular's), MTL's Ks.  (glTF's specular factor is
-     * read: the coat's scale.) */
+     * KHR_materials_specular's), or a specular colour that is not grey:
+     * glTF's specular factor and MTL's Ks are read as the coat's strength,
+     * which is white. */
     has[MESH_UNUSED_SPECULAR] =
         aiGetMaterialTextureCount(am, aiTextureType_SPECULAR) ||
         (!gltf && aiGetMaterialColor(am, AI_MATKEY_COLOR_SPECULAR, &c) == aiReturn_SUCCESS &&
-         (c.r > 0 || c.g > 0 || c.b > 0));
+         (fabsf(c.r - c.g) > 1e-3f || fabsf(c.g - c.b) > 1e-3f));
     has[MESH_UNUSED_CLEARCOAT] = (model_material_float(am, AI_MATKEY_CLEARCOAT_FACTOR, &v) && v > 0) ||
                                  aiGetMaterialTextureCount(am, aiTextureType_CLEARCOAT);
     has[MESH_UNUSED_SHEEN] =

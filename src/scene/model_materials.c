@@ -297,9 +297,16 @@ static void map_material(const struct aiMaterial *am, int gltf, int obj, double 
     s->mat.roughness = s->roughness;
     /* glTF's non-metals have a dielectric layer (F0 = 0.04 at the
      * material's roughness) over the base colour: the coat, scaled by
-     * KHR_materials_specular's factor (read from the file). */
+     * KHR_materials_specular's factor (read from the file).  MTL's Ks is
+     * a Phong highlight's colour; as Blender's OBJ importer does, its mean
+     * is the strength of a dielectric layer whose F0 is 0.08 times it
+     * (Principled's "Specular"), so s = 2 mean(Ks): Blender writes Ks 0.5
+     * for its default, F0 0.04. */
+    vec3 ks;
     if (gltf)
         s->mat.specular = specular;
+    else if (obj && get_color(am, AI_MATKEY_COLOR_SPECULAR, &ks))
+        s->mat.specular = clamp01(2.0 * (ks.x + ks.y + ks.z) / 3.0);
     s->texture = s->emissive_texture = -1;
     s->rough_map.texture = s->metal_map.texture = s->normal_texture = -1;
     s->normal_scale = 1.0;
