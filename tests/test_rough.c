@@ -331,6 +331,37 @@ static void test_coat_furnace(void **state)
     }
 }
 
+/* The same furnace on a mesh seen at 45 degrees: its pixels take the 8 x 8
+ * detail samples, whose shares of the coat's level-0 light samples are
+ * below one each, so a stratified few of them take them, weighted by
+ * their inverse probability (rough.c).  A white coated plane under a white
+ * sky returns the sky: with the weights left out the coat's share (about
+ * 5%) would be missing. */
+static void test_coat_furnace_detail(void **state)
+{
+    (void)state;
+    const char *obj = test_write_file("coat_quad.obj", "v -50 0 -50\nv 50 0 -50\nv 50 0 50\n"
+                                                       "v -50 0 50\nf 1 3 2\nf 1 4 3\n");
+    char text[1024];
+    snprintf(text, sizeof text,
+             "{\"scene\": [{\"sky\": {\"color\": [1, 1, 1]}}, {\"mesh\": {\"file\": \"%s\", "
+             "\"material\": {\"character\": {\"diffuse\": 1, \"metallic\": 0, \"reflecting\": 0, "
+             "\"refractive\": 0}, \"color\": [1, 1, 1], \"specular\": 1, \"roughness\": 0.3}}}], "
+             "\"camera\": {\"position\": [0, 5, 0], \"lookat\": [0, 0, 5], \"fov\": 20, "
+             "\"gridresolution\": [16, 16]}}",
+             obj);
+    zt_scene *s = test_scene_text(text, "coat_furnace_detail");
+    zt_image *im = test_render_level(s, ZT_METHOD_ZONE, 1, 1, 1);
+    double sum = 0;
+    for (int i = 0; i < 3 * im->width * im->height; i++)
+        sum += im->pixels[i];
+    double mean = sum / (3 * im->width * im->height);
+    print_message("zone: white furnace, coated white mesh at 45 degrees: %.5f\n", mean);
+    assert_true(fabs(mean - 1) < 0.005);
+    zt_image_release(im);
+    zt_scene_release(s);
+}
+
 /* A grey diffuse plane under a clear coat in the sun, seen from wo: the
  * base's c/pi (1 - E(cos_o)) E cos_s plus the coat's GGX reflection of the
  * sun's disc, E the coat's albedo at cos_o, both integrated here. */
@@ -381,6 +412,7 @@ int main(void)
         cmocka_unit_test(test_sun_coloured_metal),
         cmocka_unit_test(test_zone_furnace),
         cmocka_unit_test(test_coat_furnace),
+        cmocka_unit_test(test_coat_furnace_detail),
         cmocka_unit_test(test_sun_on_coat),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -294,6 +294,32 @@ static int sample_count(int per_pixel, double share, int least)
     return k > least ? k : least;
 }
 
+/* The same for level 0's light samples and directions, which aim at the
+ * lights: where a sample's share is worth fewer than `least` points, it
+ * takes `least` of them with probability p = per_pixel x share / least,
+ * weighted 1/p (*gain), or none.  The choice is stratified along the
+ * pixel's samples (sample i takes them where i p + phase passes an
+ * integer), so the pixel takes about its own count.  A mesh's 8 x 8
+ * detail samples would otherwise take `least` each: for a coat (a tenth of
+ * a surface's light), 2.5 times the pixel's count.  On the engine room
+ * (512 x 512, one saved forest) Phase Two 9% shorter for 0.771% -> 0.777%
+ * per pixel; the directions that read the forest (levels 1 and up) keep
+ * `least` a sample: chosen the same way they took the error to 0.93%. */
+static int light_sample_count(int per_pixel, double share, int least,
+                              const zone_gather_slot *slot, double *gain)
+{
+    double want = per_pixel * share;
+    *gain = 1.0;
+    if (want + 0.5 >= least)
+        return sample_count(per_pixel, share, least);
+    double p = want / least;
+    double c = slot->sample * p + frac_f(0.5 + slot->pixel * GOLDEN);
+    if (floor(c + p) == floor(c))
+        return 0;
+    *gain = 1.0 / p;
+    return least;
+}
+
 /* Where a sample's points lie in the sequence, and in which set of
  * numbers: a camera sample's pixel has its own stretch, which its samples
  * take interleaved (sample i of n the points i, i + n, i + 2n, ...), so
@@ -361,7 +387,10 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
      * read no forest (a ray each), and a light's highlight in a glossy lobe
      * is small and bright. */
     if (lo == 0) {
-        int k0 = camera ? sample_count(q->rough_light_pixel, share, q->rough_sample) : 1;
+        double gain0 = 1.0;
+        int k0 = camera ? light_sample_count(q->rough_light_pixel, share, q->rough_sample, &slot,
+                                             &gain0)
+                        : 1;
         vec3 l0 = v3(0, 0, 0);
         for (int k = 0; k < k0; k++) {
             point_numbers pn;
@@ -369,7 +398,8 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
             l0 = v3_add(l0, light_samples(t, s, &fr, lobes, weight_sum, &pn, flags));
             l0 = v3_add(l0, lobe_ray(t, s, &fr, lobes, weight_sum, &pn, 0, 0, exact_direct | cflags));
         }
-        sum = v3_add(sum, v3_scale(l0, (double)k_max / k0));
+        if (k0 > 0)
+            sum = v3_add(sum, v3_scale(l0, gain0 * k_max / k0));
         lo = 1;
     }
     /* What the lobe's rays meet: a mesh gathers a share of the camera
