@@ -127,6 +127,50 @@ static void test_depth_one_takes_exact_direct_light(void **state)
     zt_image_release(full);
 }
 
+/* A coated white sphere in a white furnace: its preview is the sky's
+ * radiance on every pixel.  The coat reflects its irradiance as a white
+ * diffuse surface of albedo s E(cos_o) (ZR_SMOOTH_COAT); its one direction
+ * a hit, taken with probability s E(cos_o) and weighed by the inverse,
+ * would put pixels at 1 - s E or far above 1. */
+static void test_coat_without_grain(void **state)
+{
+    (void)state;
+    zt_scene *s = test_scene_text(
+        "{\"scene\": [{\"sky\": {\"color\": [1, 1, 1]}}, {\"sphere\": {\"center\": [0, 0, 0], "
+        "\"radius\": 1, \"material\": {\"character\": {\"diffuse\": 1, \"metallic\": 0, "
+        "\"reflecting\": 0, \"refractive\": 0}, \"color\": [1, 1, 1], \"specular\": 1, "
+        "\"roughness\": 0.3}}}], \"camera\": {\"position\": [0, 0, 4], \"lookat\": [0, 0, 0], "
+        "\"fov\": 30, \"gridresolution\": [32, 32]}}",
+        "coat_preview");
+    zt_render_options o = zt_render_options_default();
+    o.method = ZT_METHOD_ZONE;
+    o.threads = 2;
+    zt_renderer *r = NULL;
+    zt_error err = {0};
+    assert_int_equal(zt_renderer_create(s, &o, &r, &err), ZT_OK);
+    zt_image *pre = zt_image_create(32, 32);
+    assert_int_equal(zt_renderer_preview(r, pre, NULL, &err), ZT_OK);
+    /* The sphere's pixels well inside its outline (it spans about 15
+     * pixels from the centre). */
+    double lo = 1e9, hi = -1e9;
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++) {
+            double dx = x + 0.5 - 16, dy = y + 0.5 - 16;
+            if (dx * dx + dy * dy > 10.0 * 10.0)
+                continue;
+            for (int k = 0; k < 3; k++) {
+                double v = pre->pixels[3 * (y * 32 + x) + k];
+                lo = fmin(lo, v);
+                hi = fmax(hi, v);
+            }
+        }
+    printf("coated white sphere in a white furnace, preview: %.4f to %.4f\n", lo, hi);
+    assert_true(lo > 0.98 && hi < 1.02);
+    zt_image_release(pre);
+    zt_renderer_release(r);
+    zt_scene_release(s);
+}
+
 /* The path tracer's preview is its sample 0. */
 static void test_path_preview_is_sample_zero(void **state)
 {
@@ -158,6 +202,7 @@ int main(void)
         cmocka_unit_test(test_all_levels_near_the_full_image),
         cmocka_unit_test(test_depth_one_takes_exact_direct_light),
         cmocka_unit_test(test_path_preview_is_sample_zero),
+        cmocka_unit_test(test_coat_without_grain),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -337,9 +337,12 @@ enum {
     ZR_WHOLE_HIT = 64,   /* the surface hit by this very ray counts whole,
                             its coverage (alpha) being the caller's: Phase
                             Two's samples are split at it (samples.c) */
-    ZR_BLURRED = 128     /* the path passed a rough lobe: caustics it meets
+    ZR_BLURRED = 128,    /* the path passed a rough lobe: caustics it meets
                             are read from the nodes, not the photons (the
                             lobe blurs them more than the nodes do) */
+    ZR_SMOOTH_COAT = 256 /* a coat reflects its irradiance as a white
+                            diffuse surface of albedo s E(cos_o) would,
+                            without rays (the preview: no grain) */
 };
 vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
                    int flags, const int *media, int media_count);

@@ -24,8 +24,12 @@ zt_status p2_render_preview(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, 
     progress prog;
     progress_init(&prog, o, "zone preview", (double)sum->height);
     uint64_t rays = 0;
-    /* A forest of depth 1 keeps no maps: its direct light is the exact one. */
-    int flags = c->f->map_levels > 0 ? 0 : ZR_EXACT_DIRECT;
+    /* A forest of depth 1 keeps no maps: its direct light is the exact one.
+     * A coat reflects its irradiance diffusely: its one direction a hit,
+     * taken by a roulette of probability s E(cos_o) (a tenth) and weighed
+     * by its inverse, speckled coated surfaces (the engine room's preview
+     * 11.9% per pixel from the reference, 8.0% without the speckle). */
+    int flags = (c->f->map_levels > 0 ? 0 : ZR_EXACT_DIRECT) | ZR_SMOOTH_COAT;
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
         zone_trace t = {.f = c->f, .r = c->r};

@@ -146,8 +146,11 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         double keep = m->coat ? 1.0 - bsdf_coat_albedo(m, -f3_dot(sh.ns, d)) : 1.0;
         out = v3_add(out, v3_scale(v3_mul(color, e),
                                    keep * m->weight[LOBE_DIFFUSE] / 3.14159265358979));
+        if (m->coat && (flags & ZR_SMOOTH_COAT))
+            out = v3_add(out, v3_scale(e, (1.0 - keep) * m->weight[LOBE_DIFFUSE] /
+                                              3.14159265358979));
     }
-    if (m->coat && hi >= 1 && !(flags & ZR_SKIP_DIFFUSE)) {
+    if (m->coat && hi >= 1 && !(flags & (ZR_SKIP_DIFFUSE | ZR_SMOOTH_COAT))) {
         zone_rough_at at = {m, h.part, xf, nf, sh.ns, color, d, 1.0f, 1.0f, p->object, 0,
                             media, media_count, 0.0f};
         out = v3_add(out, zone_coat_on_the_way(t, &at, lo - 1, hi - 1, flags));
@@ -181,7 +184,7 @@ vec3 zone_radiance(zone_trace *t, vec3f o, vec3f d, int lo, int hi,
         }
         /* Under ZR_NO_CAUSTIC every specular ray passes it on, and marks
          * the rays that leave a caustic target. */
-        int cflags = flags & ZR_BLURRED;
+        int cflags = flags & (ZR_BLURRED | ZR_SMOOTH_COAT);
         if (flags & ZR_NO_CAUSTIC)
             cflags |= ZR_NO_CAUSTIC | (specular_target_part(rs, h.part) ? ZR_CAUSTIC_LIGHT : 0);
         if (k_refl > 0) {
