@@ -5,16 +5,25 @@
 
 #include "ggx_albedo_tables.h"
 
+/* The roughness row below alpha and the fraction toward the next. */
+static int rough_row(float alpha, float *fy)
+{
+    float y = f_clamp01(sqrtf(alpha)) * (GGX_ROUGH_N - 1);
+    int yi = (int)y;
+    if (yi > GGX_ROUGH_N - 2)
+        yi = GGX_ROUGH_N - 2;
+    *fy = y - (float)yi;
+    return yi;
+}
+
 /* Bilinear lookup in one [roughness][cos] slice. */
 static float lookup(const float t[GGX_ROUGH_N][GGX_COS_N], float cos_o, float alpha)
 {
-    float x = f_clamp01(cos_o) * (GGX_COS_N - 1), y = f_clamp01(sqrtf(alpha)) * (GGX_ROUGH_N - 1);
-    int xi = (int)x, yi = (int)y;
+    float x = f_clamp01(cos_o) * (GGX_COS_N - 1), fy;
+    int xi = (int)x, yi = rough_row(alpha, &fy);
     if (xi > GGX_COS_N - 2)
         xi = GGX_COS_N - 2;
-    if (yi > GGX_ROUGH_N - 2)
-        yi = GGX_ROUGH_N - 2;
-    float fx = x - (float)xi, fy = y - (float)yi;
+    float fx = x - (float)xi;
     float a = t[yi][xi] + fx * (t[yi][xi + 1] - t[yi][xi]);
     float b = t[yi + 1][xi] + fx * (t[yi + 1][xi + 1] - t[yi + 1][xi]);
     return a + fy * (b - a);
@@ -32,11 +41,8 @@ float ggx_albedo_coat(float cos_o, float alpha)
 
 float ggx_albedo_coat_average(float alpha)
 {
-    float y = f_clamp01(sqrtf(alpha)) * (GGX_ROUGH_N - 1);
-    int yi = (int)y;
-    if (yi > GGX_ROUGH_N - 2)
-        yi = GGX_ROUGH_N - 2;
-    float fy = y - (float)yi;
+    float fy;
+    int yi = rough_row(alpha, &fy);
     return ggx_coat_average[yi] + fy * (ggx_coat_average[yi + 1] - ggx_coat_average[yi]);
 }
 

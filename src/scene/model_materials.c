@@ -225,9 +225,10 @@ static int material_texture(model_textures *tx, const struct aiMaterial *am, zt_
     return -1;
 }
 
-/* One material of the file as a slot; strength: glTF's emissiveStrength
- * as read from the file (gltf_extensions.h; 1 for other formats), for an
- * Assimp that does not give it. */
+/* One material of the file as a slot; strength and specular: glTF's
+ * emissiveStrength and specularFactor as read from the file
+ * (gltf_extensions.h; 1 for other formats), which Assimp 5.2 does not
+ * give. */
 static void map_material(const struct aiMaterial *am, int gltf, int obj, double strength,
                          double specular, mesh_slot *s)
 {
