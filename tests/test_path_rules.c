@@ -13,6 +13,10 @@
 #include <string.h>
 #include <time.h>
 
+#include "geom/accel.h"
+#include "path/path_tracer.h"
+#include "render/render_scene.h"
+#include "util/sampler.h"
 #include "zonetrace/render.h"
 #include "zonetrace/scene.h"
 
@@ -395,6 +399,82 @@ static void test_background_does_not_shadow(void **state)
     free(cj);
 }
 
+/* A plain scene (rscene.plain: smooth lobes only, nothing textured, no
+ * panes, alpha or light from far away) is traced by a copy of the loop
+ * compiled without those branches.  Both copies must give the same bytes
+ * on it: the copy is a speed-up, never another estimator.  And the flag
+ * must see what makes a scene not plain. */
+static void test_plain_copy_same_bytes(void **state)
+{
+    (void)state;
+    const char *plain[] = {"cornell.json", "materials.json", "pointlights.json"};
+    for (int f = 0; f < 3; f++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/scenes/%s", ZT_SOURCE_DIR, plain[f]);
+        zt_scene *s = NULL;
+        zt_error err = {0};
+        if (zt_scene_load_file(path, &s, &err) != ZT_OK)
+            fail_msg("%s: %s", path, err.message);
+        rscene rs;
+        assert_int_equal(rscene_build(&rs, s, NULL, 0, ACCEL_BVH, &err), ZT_OK);
+        if (!rs.plain)
+            fail_msg("%s is not taken as plain", plain[f]);
+        const zt_camera cam = zt_scene_get_camera(s), *sc = &cam;
+        tcam c;
+        for (int a = 0; a < 3; a++) {
+            c.vp[a] = sc->viewpoint[a];
+            c.tl[a] = sc->screen[0][a];
+            c.tr[a] = sc->screen[1][a];
+            c.bl[a] = sc->screen[2][a];
+            c.br[a] = sc->screen[3][a];
+        }
+        c.w = c.h = 16;
+        const int n = 16, spp = 8, count = n * n * spp;
+        vec3f *l[2];
+        uint64_t rays[2] = {0, 0};
+        path_params pp = {0, 6, 1};
+        for (int copy = 0; copy < 2; copy++) {
+            rs.plain = copy == 0;
+            l[copy] = malloc((size_t)count * sizeof(vec3f));
+            for (int i = 0; i < n * n; i++) {
+                path_pixel px = path_pixel_make(sampler_hash3((uint32_t)i, 7u, 1u));
+                for (uint32_t k = 0; k < (uint32_t)spp; k++) {
+                    double o[3], d[3];
+                    cam_ray(&c, i % n + (k + 0.5) / spp, i / n + 0.5, o, d);
+                    l[copy][i * spp + (int)k] = path_trace_sample(
+                        &rs, &pp, f3((float)o[0], (float)o[1], (float)o[2]),
+                        f3((float)d[0], (float)d[1], (float)d[2]), &px, k,
+                        sampler_reverse_bits(k), &rays[copy]);
+                }
+            }
+        }
+        assert_memory_equal(l[0], l[1], (size_t)count * sizeof(vec3f));
+        assert_true(rays[0] == rays[1] && rays[0] > (uint64_t)count);
+        free(l[0]);
+        free(l[1]);
+        rscene_free(&rs);
+        zt_scene_release(s);
+    }
+    const char *not_plain[] = {"cornell_rough.json", "sun_and_sky.json", "textured_box.json",
+                               "house_inside.json"};
+    for (int f = 0; f < 4; f++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/scenes/%s", ZT_SOURCE_DIR, not_plain[f]);
+        zt_scene *s = NULL;
+        zt_error err = {0};
+        if (zt_scene_load_file(path, &s, &err) != ZT_OK) {
+            printf("  %s not loaded (%s): skipped\n", not_plain[f], err.message);
+            continue;
+        }
+        rscene rs;
+        assert_int_equal(rscene_build(&rs, s, NULL, 0, ACCEL_BVH, &err), ZT_OK);
+        if (rs.plain)
+            fail_msg("%s is taken as plain", not_plain[f]);
+        rscene_free(&rs);
+        zt_scene_release(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -402,6 +482,7 @@ int main(void)
         TIMED_TEST(test_seeds_and_threads),
         TIMED_TEST(test_visibility_rules),
         TIMED_TEST(test_background_does_not_shadow),
+        TIMED_TEST(test_plain_copy_same_bytes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

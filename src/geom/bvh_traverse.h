@@ -111,26 +111,31 @@ static inline int bvh_triangle_packet(const bvh_packet *q, const ray4 *r,
 {
     f4 dx = r->dx, dy = r->dy, dz = r->dz;
     const f4 *e1 = q->e1, *e2 = q->e2;
-    f4 pvx = dy * e2[2] - dz * e2[1];
-    f4 pvy = dz * e2[0] - dx * e2[2];
-    f4 pvz = dx * e2[1] - dy * e2[0];
-    f4 det = e1[0] * pvx + e1[1] * pvy + e1[2] * pvz;
-    f4 inv = f4_splat(1.0f) / det;
     f4 tvx = r->ox - q->p0[0], tvy = r->oy - q->p0[1], tvz = r->oz - q->p0[2];
-    f4 u = (tvx * pvx + tvy * pvy + tvz * pvz) * inv;
-    f4 qvx = tvy * e1[2] - tvz * e1[1];
-    f4 qvy = tvz * e1[0] - tvx * e1[2];
-    f4 qvz = tvx * e1[1] - tvy * e1[0];
-    f4 v = (dx * qvx + dy * qvy + dz * qvz) * inv;
     const f4 *n = q->n;
     f4 dn = n[0] * dx + n[1] * dy + n[2] * dz;
     /* Lanes with dn = 0 get inf or NaN here and are misses below. */
     *t = -(n[0] * tvx + n[1] * tvy + n[2] * tvz) / dn;
     f4 zero = f4_splat(0.0f), one = f4_splat(1.0f);
+    i4 in_range = (*t > zero) & (*t < f4_splat(tmax));
+    /* No plane met within reach (a shadow ray ending just short of its
+     * light): the rest of the test cannot accept a lane. */
+    if (!i4_bits(in_range))
+        return 0;
+    f4 pvx = dy * e2[2] - dz * e2[1];
+    f4 pvy = dz * e2[0] - dx * e2[2];
+    f4 pvz = dx * e2[1] - dy * e2[0];
+    f4 det = e1[0] * pvx + e1[1] * pvy + e1[2] * pvz;
+    f4 inv = f4_splat(1.0f) / det;
+    f4 u = (tvx * pvx + tvy * pvy + tvz * pvz) * inv;
+    f4 qvx = tvy * e1[2] - tvz * e1[1];
+    f4 qvy = tvz * e1[0] - tvx * e1[2];
+    f4 qvz = tvx * e1[1] - tvy * e1[0];
+    f4 v = (dx * qvx + dy * qvy + dz * qvz) * inv;
     i4 miss = (q->culled & ((det <= zero) | (dn >= zero))) |
               (~q->culled & ((det == zero) | (dn == zero))) |
               (u < zero) | (u > one) | (v < zero) | (u + v > one);
-    i4 hit = ~miss & (*t > zero) & (*t < f4_splat(tmax));
+    i4 hit = ~miss & in_range;
     return i4_bits(hit);
 }
 

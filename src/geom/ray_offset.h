@@ -61,8 +61,11 @@ static inline vec3f ray_offset(vec3f p, vec3f n)
  * stretch, and ending at the 32 units alone costs the Cornell box 12%. */
 static inline float shadow_ray_end(vec3f o, vec3f target, float dist)
 {
-    float m = f_max(f_max(f_max(fabsf(o.x), fabsf(o.y)), f_max(fabsf(o.z), fabsf(target.x))),
-                    f_max(f_max(fabsf(target.y), fabsf(target.z)), 1.0f));
+    /* The largest magnitude (at least 1) in vector lanes: exact, as max is. */
+    const i4 abs_bits = i4_splat(0x7fffffff);
+    f4 a = (f4)((i4)(f4){o.x, o.y, o.z, 1.0f} & abs_bits);
+    f4 b = (f4)((i4)(f4){target.x, target.y, target.z, 1.0f} & abs_bits);
+    float m = f4_hmax(f4_max(a, b))[0];
     float end = dist - f_max(32.0f * 1.1920929e-7f * m, 1e-5f * dist);
     return end > 0.5f * dist ? end : 0.5f * dist;
 }

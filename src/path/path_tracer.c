@@ -86,10 +86,14 @@ path_pixel path_pixel_make(uint32_t key)
     return px;
 }
 
-__attribute__((flatten))
-vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
-                        vec3f d, const path_pixel *px, uint32_t index,
-                        uint32_t rev_index, uint64_t *rays)
+/* The loop, with `plain` a constant in each of its two copies: in a plain
+ * scene (rscene.plain) the branches for what it lacks fold away. */
+#define HAS(feature) (!plain && (feature))
+
+__attribute__((always_inline))
+static inline vec3f trace(const rscene *rs, const path_params *pp, vec3f o, vec3f d,
+                          const path_pixel *px, uint32_t index, uint32_t rev_index,
+                          uint64_t *rays, const int plain)
 {
     vec3f radiance = f3_splat(0.0f), beta = f3_splat(1.0f);
     int k = 0;                /* scattering events so far */
@@ -111,7 +115,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         if (h.part < 0) {
             if (counted) {
                 vec3f le = rs->sky;
-                if (__builtin_expect(rs->distant.any, 0)) {
+                if (__builtin_expect(HAS(rs->distant.any), 0)) {
                     float far_pdf;
                     vec3f ld = distant_eval(&rs->distant, d, &far_pdf);
                     if (!prev_delta && !f3_is_black(ld))
@@ -146,7 +150,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
          * cov times the pane's, and the covered share that does not pass
          * is the material as it is (the pane's lobe reflecting only). */
         float pane_keep = 1.0f, pane_r = 0.0f;
-        if (__builtin_expect(rs_passes(m), 0)) {
+        if (__builtin_expect(HAS(rs_passes(m)), 0)) {
             vec3f ng = shape_normal(p, x);
             float c = f3_dot(ng, d);
             float cov = rs_coverage(rs, h.part, p, m, x), p_pane = 0.0f;
@@ -182,7 +186,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         vec3f ns = n;
         int bent = 0;
         rs_object textured;
-        if (rs_needs_shade(rs, h.part, m)) {
+        if (HAS(rs_needs_shade(rs, h.part, m))) {
             rs_shade sh;
             rs_shade_at(rs, h.part, p, m, x, n, &sh);
             ns = sh.ns;
@@ -194,7 +198,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             }
         }
         rs_object pane_vertex;
-        if (__builtin_expect(m->thin, 0)) {
+        if (__builtin_expect(HAS(m->thin), 0)) {
             pane_vertex = *m;
             float inv = 1.0f / pane_keep;
             int lobes = 0;
@@ -207,7 +211,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
             m = &pane_vertex;
         }
         uint32_t pair = 1 + (uint32_t)(k - 1) * PAIRS_PER_VERTEX;
-        int nee = k >= pp->min_level && (m->weight[LOBE_DIFFUSE] > 0.0f || m->rough);
+        int nee = k >= pp->min_level && (m->weight[LOBE_DIFFUSE] > 0.0f || HAS(m->rough));
         /* Numbers from the stream are drawn only where a choice needs
          * them: most materials have one lobe, most scenes few lights. */
         float u_light[2] = {0.0f, 0.0f}, u_dir[2];
@@ -244,10 +248,13 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
         if (nee && light_sample_point(rs, x, u_select, u_light, &ls) && !f3_is_black(ls.li)) {
             float bsdf_pdf = 0.0f;
             vec3f fcos = f3_splat(0.0f), rough = f3_splat(0.0f);
-            int below = f3_dot(n, ls.wi) <= 0.0f;
+            /* (Below the surface only rough lobes and bent normals see
+             * light: never in a plain scene.) */
+            int below = HAS(f3_dot(n, ls.wi) <= 0.0f);
             if (!bent || !below)
-                fcos = bsdf_eval_base(m, ns, ls.wi, f3_dot(ns, wo), &bsdf_pdf);
-            if (m->rough | m->coat)
+                fcos = plain ? bsdf_eval_diffuse(m, ns, ls.wi, &bsdf_pdf)
+                             : bsdf_eval_base(m, ns, ls.wi, f3_dot(ns, wo), &bsdf_pdf);
+            if (HAS(m->rough | m->coat))
                 rough = nee_rough(m, &frame, n, wo, ls.wi, eta_i, eta_t, ls.pdf, ls.delta);
             if (bsdf_pdf > 0.0f || !f3_is_black(rough)) {
                 n_rays++;
@@ -272,13 +279,14 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                                           f3_scale(f3_mul(f3_mul(f3_mul(beta, fcos), ls.li), tr),
                                                    w_over_pdf));
                     }
-                    radiance = f3_add(radiance, f3_mul(f3_mul(f3_mul(beta, rough), ls.li), tr));
+                    if (HAS(m->rough | m->coat))
+                        radiance = f3_add(radiance, f3_mul(f3_mul(f3_mul(beta, rough), ls.li), tr));
                 }
             }
         }
 
         /* Next-event estimation of light from far away. */
-        if (__builtin_expect(nee && rs->distant.any, 0)) {
+        if (__builtin_expect(nee && HAS(rs->distant.any), 0)) {
             float u_far[2], u_pick = rs->distant.map && rs->distant.sun ? sampler_next(&rng) : 0.0f;
             if (k <= STRATIFIED_VERTICES) {
                 sampler_get2_seeded(px->pair_seed[DISTANT_PAIR], rev_index, u_far);
@@ -294,7 +302,7 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
                 int below = f3_dot(n, wi) <= 0.0f;
                 if (!bent || !below)
                     fcos = bsdf_eval_base(m, ns, wi, f3_dot(ns, wo), &bsdf_pdf);
-                if (m->rough | m->coat)
+                if (HAS(m->rough | m->coat))
                     rough = nee_rough(m, &frame, n, wo, wi, eta_i, eta_t, far_pdf, 0);
                 if (bsdf_pdf > 0.0f || !f3_is_black(rough)) {
                     n_rays++;
@@ -370,4 +378,33 @@ vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
     if (!isfinite(radiance.x) || !isfinite(radiance.y) || !isfinite(radiance.z))
         return f3_splat(0.0f);
     return radiance;
+}
+
+#undef HAS
+
+/* Each copy flattened on its own (every call inlined, so the loop's
+ * registers do not spill around calls); in one function together they
+ * were allocated worse than either alone. */
+__attribute__((flatten, noinline))
+static vec3f trace_plain(const rscene *rs, const path_params *pp, vec3f o, vec3f d,
+                         const path_pixel *px, uint32_t index, uint32_t rev_index,
+                         uint64_t *rays)
+{
+    return trace(rs, pp, o, d, px, index, rev_index, rays, 1);
+}
+
+__attribute__((flatten, noinline))
+static vec3f trace_general(const rscene *rs, const path_params *pp, vec3f o, vec3f d,
+                           const path_pixel *px, uint32_t index, uint32_t rev_index,
+                           uint64_t *rays)
+{
+    return trace(rs, pp, o, d, px, index, rev_index, rays, 0);
+}
+
+vec3f path_trace_sample(const rscene *rs, const path_params *pp, vec3f o,
+                        vec3f d, const path_pixel *px, uint32_t index,
+                        uint32_t rev_index, uint64_t *rays)
+{
+    return rs->plain ? trace_plain(rs, pp, o, d, px, index, rev_index, rays)
+                     : trace_general(rs, pp, o, d, px, index, rev_index, rays);
 }

@@ -275,12 +275,17 @@ zt_status rscene_build(rscene *rs, const zt_scene *scene,
         rscene_free(rs);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     }
+    int plain_objects = 1;
     for (int i = 0; i < rs->object_count; i++) {
         rs_object *ro = &rs->objects[i];
         simplify_alpha(ro);
         rs->pane_count += rs_passes(ro) != 0;
         rs->alpha_count += ro->alpha_mode != ALPHA_OPAQUE;
+        plain_objects &= !ro->rough && !ro->coat && !ro->thin && !ro->texture && !ro->maps;
     }
+    for (int k = 0; k < rs->mesh_count; k++)
+        plain_objects &= !rs->meshes[k].smooth;
+    rs->plain = plain_objects && !rs->distant.any && rs->pane_count == 0 && rs->alpha_count == 0;
 
     double total = 0;
     for (int i = 0; i < scene->part_count; i++) {

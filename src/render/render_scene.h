@@ -162,6 +162,10 @@ typedef struct rscene {
                            queries then see through them (transmittance.h) */
     int alpha_count;    /* objects with a coverage (alpha_mode): nearest-hit
                            queries skip their holes (accel.h) */
+    int plain;          /* nothing but smooth lobes, untextured, without
+                           maps, panes, alpha, smooth meshes or light from
+                           far away: the path tracer's loop has a copy
+                           compiled without those branches */
     int *point_lights;  /* point-light parts, switched off or not */
     int point_light_count;
     /* Infinite planes of each layer ([0] foreground, [1] background), kept

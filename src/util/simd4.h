@@ -60,6 +60,22 @@ static inline f4 f4_hmin(f4 a)
 #endif
 }
 
+/* The largest lane, in every lane. */
+static inline f4 f4_hmax(f4 a)
+{
+#ifdef __SSE__
+    __m128 v = (__m128)a;
+    v = _mm_max_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+    v = _mm_max_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 0, 3, 2)));
+    return (f4)v;
+#else
+    float m = a[0];
+    for (int i = 1; i < 4; i++)
+        m = a[i] > m ? a[i] : m;
+    return f4_splat(m);
+#endif
+}
+
 /* Bit i set when lane i of the mask is true. */
 static inline int i4_bits(i4 m)
 {
