@@ -308,6 +308,52 @@ static void test_sky_splits_share_the_directions(void **state)
     }
 }
 
+/* A pane (light passes part of it) is no shadow that clipping can draw, so
+ * a point it may shade sees the light by rays (direct_rays_take counts
+ * them); a point whose pyramid to the light it misses is clipped exactly, though the pane's box
+ * (what the occluder index tests) holds that pyramid: a long diagonal
+ * sliver of glass halfway up, across the floor. */
+static void test_pane_beside_the_pyramid(void **state)
+{
+    (void)state;
+    zt_scene *scene = test_scene_text(
+        "{\"camera\": {\"position\": [0, 8, -30], \"lookat\": [0, 0, 0], "
+        "\"up\": [0, 1, 0], \"fov\": 50, \"gridresolution\": [8, 8]}, \"scene\": ["
+        TRIANGLE_LIGHT
+        "{\"plane\": {\"normal\": [0, 1, 0], \"offset\": 0, " TEST_DIFFUSE(0.5) "}},"
+        "{\"triangle\": {\"points\": [[-10, 5, -10.5], [-10, 5, -9.5], [10, 5, 10]], "
+        "\"material\": {\"character\": {\"diffuse\": 0, \"metallic\": 0, \"reflecting\": 0, "
+        "\"refractive\": 1}, \"color\": [1, 1, 1], \"refractiveindex\": 1.5, "
+        "\"thin\": true}}}]}",
+        "direct_pane.json");
+    zt_renderer *r = test_zone_renderer(scene, 1, 1, zt_render_options_default().quality);
+    assert_int_equal(r->rs.light_count, 1);
+    assert_true(r->rs.pane_count == 1);
+    int light = r->rs.lights[0].part, floor_part = -1;
+    for (int i = 0; i < r->rs.part_count; i++)
+        if (r->rs.parts[i].shape == SHAPE_PLANE)
+            floor_part = i;
+    const direct_ctx *c = &r->forest->direct;
+    vec3 up = v3(0, 1, 0), tri[3] = {v3(-2, 10, -2), v3(2, 10, -2), v3(0, 10, 2)};
+    /* Under the sliver: by rays, which see through the glass (less its
+     * reflection, so less than the open light). */
+    vec3 under = v3(0, 0, 0.2);
+    direct_rays_take();
+    double seen = direct_irradiance(c, light, under, up, floor_part);
+    assert_true(direct_rays_take() > 0);
+    double open = lambert_polygon(under, up, tri, 3);
+    assert_true(seen > 0.5 * open && seen < 0.99 * open);
+    /* Beside it: the sliver's box holds the pyramid, the sliver does not
+     * meet it; clipped exactly, all of the light. */
+    vec3 beside = v3(8, 0, -8);
+    double exact = direct_irradiance(c, light, beside, up, floor_part);
+    assert_true(direct_rays_take() == 0);
+    open = lambert_polygon(beside, up, tri, 3);
+    assert_true(fabs(exact - open) <= 1e-9 * open);
+    zt_renderer_release(r);
+    zt_scene_release(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -315,6 +361,7 @@ int main(void)
         cmocka_unit_test(test_splits_share_the_rays),
         cmocka_unit_test(test_sphere_light_by_rays),
         cmocka_unit_test(test_sky_splits_share_the_directions),
+        cmocka_unit_test(test_pane_beside_the_pyramid),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

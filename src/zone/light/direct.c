@@ -412,6 +412,34 @@ static void shadow_region(const zprim *light, const light_frame *f, vec3 x, cons
     *out_fr = fr;
 }
 
+/* Whether primitive o, which lets part of the light through (a pane, or a
+ * surface with holes or partial coverage), can shadow the light seen from
+ * x at all: the occluder index tests boxes, and a large masked panel's box
+ * meets many pyramids that its triangles miss.  A triangle wholly outside
+ * one of the pyramid's side planes, below x's horizon, not between the
+ * light's plane and x, or culled from x's side casts no shadow there (the
+ * tests occlude_with and cut_shadow make); other shapes may. */
+static int passing_may_shadow(const zprim *light, const light_frame *f, vec3 x, vec3 n,
+                              const zprim *o, const frustum *fr)
+{
+    if (o->background && !light->background)
+        return 0;
+    if (o->shape != SHAPE_TRIANGLE || light->background)
+        return 1;
+    if (outside_frustum(fr, x, o->p, 3))
+        return 0;
+    vec3 nt = v3_cross(v3_sub(o->p[1], o->p[0]), v3_sub(o->p[2], o->p[0]));
+    if (o->culled && v3_dot(nt, v3_sub(x, o->p[0])) <= 0)
+        return 0;
+    int above = 0, before = 0;
+    double s = f->hx > 0 ? 1.0 : -1.0;
+    for (int i = 0; i < 3; i++) {
+        above |= v3_dot(n, v3_sub(o->p[i], x)) > 0;
+        before |= s * height(f, o->p[i]) > 0;
+    }
+    return above && before;
+}
+
 /* Cuts the shadows of every primitive but the receiver and the light out
  * of the pieces.  Returns 1 when done, 0 when x is enclosed and sees
  * nothing, -1 when more occluders stand in the way than clipping takes
@@ -442,10 +470,16 @@ static int cut_occluders(const direct_ctx *c, int light, const light_frame *f, v
             continue;
         /* A pane, or a surface with holes or partial coverage (alpha),
          * lets part of the light through: not a shadow that clipping can
-         * draw, so its points take rays (which see through it). */
+         * draw, so where it may cast one the point takes rays (which see
+         * through it). */
         rs_part tmp;
-        if (c->rs->pane_count && rs_passes(&c->rs->objects[rs_prim(c->rs, cand[k], &tmp)->object]))
-            return -1;
+        if (c->rs->pane_count && rs_passes(&c->rs->objects[rs_prim(c->rs, cand[k], &tmp)->object])) {
+            zprim o;
+            zprim_get(c->scene, c->rs, cand[k], &o);
+            if (passing_may_shadow(&lpp, f, x, n, &o, &fr))
+                return -1;
+            continue;
+        }
         if (occlude_by(c, cand[k], &lpp, f, x, n, &fr, set, scratch))
             return 0;
     }
