@@ -65,7 +65,10 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
     hit *kept = NULL;
     int reuse = 0;
     zone_gather_memo *memo = t->memo;
-    if (memo && slot.sample < ZONE_MEMO_SAMPLES &&
+    /* Only a camera sample's own gather keeps its hits (samples > 0): a
+     * rough lobe's or a coat's direction that meets a mesh gathers there
+     * too, and would take sample 0's room. */
+    if (memo && slot.samples > 0 && slot.sample < ZONE_MEMO_SAMPLES &&
         ((size_t)slot.sample + 1) * (size_t)k_max <= ZONE_MEMO_HITS) {
         if (memo->pixel != slot.pixel) {
             memo->pixel = slot.pixel;
