@@ -225,6 +225,22 @@ static int outside_frustum(const frustum *fr, vec3 x, const vec3 *p, int count)
     return 0;
 }
 
+/* Whether triangle o surely casts no shadow at x: wholly outside one of the
+ * pyramid's side planes, culled from x's side, or below x's horizon. */
+static int triangle_misses(const frustum *fr, vec3 x, vec3 n, const zprim *o)
+{
+    if (outside_frustum(fr, x, o->p, 3))
+        return 1;
+    vec3 nt = v3_cross(v3_sub(o->p[1], o->p[0]), v3_sub(o->p[2], o->p[0]));
+    /* A culled triangle lets rays from behind through. */
+    if (o->culled && v3_dot(nt, v3_sub(x, o->p[0])) <= 0)
+        return 1;
+    int above = 0;
+    for (int i = 0; i < 3; i++)
+        above |= v3_dot(n, v3_sub(o->p[i], x)) > 0;
+    return !above;
+}
+
 static int occlude_with(const direct_ctx *c, const light_frame *f, vec3 x,
                         vec3 n, const zprim *o, int beyond,
                         const frustum *fr, poly2_set *set, poly2 *scratch)
@@ -232,16 +248,7 @@ static int occlude_with(const direct_ctx *c, const light_frame *f, vec3 x,
     poly3 poly;
     switch (o->shape) {
     case SHAPE_TRIANGLE: {
-        if (outside_frustum(fr, x, o->p, 3))
-            return 0;
-        vec3 nt = v3_cross(v3_sub(o->p[1], o->p[0]), v3_sub(o->p[2], o->p[0]));
-        /* A culled triangle lets rays from behind through. */
-        if (o->culled && v3_dot(nt, v3_sub(x, o->p[0])) <= 0)
-            return 0;
-        int above = 0;
-        for (int i = 0; i < 3; i++)
-            above |= v3_dot(n, v3_sub(o->p[i], x)) > 0;
-        if (!above)
+        if (triangle_misses(fr, x, n, o))
             return 0;
         poly.n = 3;
         for (int i = 0; i < 3; i++)
@@ -415,10 +422,10 @@ static void shadow_region(const zprim *light, const light_frame *f, vec3 x, cons
 /* Whether primitive o, which lets part of the light through (a pane, or a
  * surface with holes or partial coverage), can shadow the light seen from
  * x at all: the occluder index tests boxes, and a large masked panel's box
- * meets many pyramids that its triangles miss.  A triangle wholly outside
- * one of the pyramid's side planes, below x's horizon, not between the
- * light's plane and x, or culled from x's side casts no shadow there (the
- * tests occlude_with and cut_shadow make); other shapes may. */
+ * meets many pyramids that its triangles miss.  A triangle that clipping
+ * would pass over (triangle_misses) or that lies wholly beyond the light's
+ * plane (cut_shadow keeps only what is between it and x) casts no shadow
+ * there; other shapes may. */
 static int passing_may_shadow(const zprim *light, const light_frame *f, vec3 x, vec3 n,
                               const zprim *o, const frustum *fr)
 {
@@ -426,18 +433,13 @@ static int passing_may_shadow(const zprim *light, const light_frame *f, vec3 x, 
         return 0;
     if (o->shape != SHAPE_TRIANGLE || light->background)
         return 1;
-    if (outside_frustum(fr, x, o->p, 3))
+    if (triangle_misses(fr, x, n, o))
         return 0;
-    vec3 nt = v3_cross(v3_sub(o->p[1], o->p[0]), v3_sub(o->p[2], o->p[0]));
-    if (o->culled && v3_dot(nt, v3_sub(x, o->p[0])) <= 0)
-        return 0;
-    int above = 0, before = 0;
     double s = f->hx > 0 ? 1.0 : -1.0;
-    for (int i = 0; i < 3; i++) {
-        above |= v3_dot(n, v3_sub(o->p[i], x)) > 0;
-        before |= s * height(f, o->p[i]) > 0;
-    }
-    return above && before;
+    for (int i = 0; i < 3; i++)
+        if (s * height(f, o->p[i]) > 0)
+            return 1;
+    return 0;
 }
 
 /* Cuts the shadows of every primitive but the receiver and the light out
