@@ -686,6 +686,20 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
 vec3 direct_irradiance_rgb(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
                            int split)
 {
+    return direct_irradiance_rays(c, light, x, n, receiver, split, c->fallback);
+}
+
+int direct_rays_by_share(const direct_ctx *c, double share)
+{
+    if (!(share < 1.0))
+        return c->fallback;
+    double k = floor(c->fallback * share);
+    return k < 1 ? 1 : (int)k;
+}
+
+vec3 direct_irradiance_rays(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
+                            int split, int count)
+{
     zprim lpp;
     light_prim(c, light, x, &lpp);
     const zprim *lp = &lpp;
@@ -716,12 +730,15 @@ vec3 direct_irradiance_rgb(const direct_ctx *c, int light, vec3 x, vec3 n, int r
         return v3(0, 0, 0);
     poly2 whole = pieces[0];
     /* Split points are only taken where shadows are busy, and there the
-     * search nearly always finds too many: it is skipped (direct.h). */
-    int cut = split > 0 && !clips_every_point(c)
+     * search nearly always finds too many: it is skipped (direct.h).  So
+     * is it for a part that takes fewer rays than the fallback's (one of
+     * a light cut into many): a search per part costs as much as tens of
+     * rays, where the parts' rays are one point's budget between them. */
+    int cut = (split > 0 || count < c->fallback) && !clips_every_point(c)
                   ? -1
                   : cut_occluders(c, light, &f, x, n, receiver, &set, &scratch);
     if (cut < 0)
-        return by_rays(c, lp, &f, &whole, x, n, c->fallback, split);
+        return by_rays(c, lp, &f, &whole, x, n, count, split);
     if (cut == 0)
         return v3(0, 0, 0);
     double e = 0;

@@ -77,6 +77,18 @@ double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, i
 vec3 direct_irradiance_rgb(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
                            int split);
 
+/* The same where the light, if seen by rays, is cut into about `count`
+ * triangles instead of the fallback's. */
+vec3 direct_irradiance_rays(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
+                            int split, int count);
+
+/* One point's rays for a light part among many (a lamp of many triangles,
+ * many lamps): the fallback's by the part's share of the light the point
+ * receives, at least one, so that a point's rays do not grow with the
+ * number of parts its light is cut into. */
+int direct_rays_by_share(const direct_ctx *c, double share);
+
+
 /* The rays this thread's direct-light calls have cast since the last
  * call (they are counted here, as the calls take no zone_trace): the
  * callers add them to their own count. */

@@ -459,8 +459,31 @@ typedef struct light_leaf_ctx {
     int receiver;
 } light_leaf_ctx;
 
-/* One light of the light tree, exactly (the side facing x only). */
-static void light_leaf(void *user, int i, vec3 x, vec3 n, double acc[3], cut_stats *st)
+/* A light element's share of the `whole` that the cut estimates x
+ * receives: its irradiance from afar (area x cosines / distance squared
+ * at its centroid), unoccluded; 1 where that cannot be told (a sphere or
+ * point, x at the element, no whole). */
+static double leaf_share(const sender_elem *el, const float em[3], vec3 x, vec3 n, double whole)
+{
+    if (el->any_way || !(whole > 0))
+        return 1.0;
+    vec3 w = v3_sub(x, v3(el->c[0], el->c[1], el->c[2]));
+    double r2 = v3_dot(w, w);
+    if (!(r2 > el->area))
+        return 1.0;
+    double r = sqrt(r2);
+    double ce = (el->n[0] * w.x + el->n[1] * w.y + el->n[2] * w.z) / r;
+    double cr = -v3_dot(n, w) / r;
+    if (ce <= 0 || cr <= 0)
+        return 0.0;
+    double lum = 0.2126 * em[0] + 0.7152 * em[1] + 0.0722 * em[2];
+    return lum * el->area * ce * cr / (r2 * whole);
+}
+
+/* One light of the light tree, exactly (the side facing x only), with its
+ * share of the point's rays. */
+static void light_leaf(void *user, int i, vec3 x, vec3 n, double whole, double acc[3],
+                       cut_stats *st)
 {
     (void)st;
     const light_leaf_ctx *lc = user;
@@ -470,8 +493,12 @@ static void light_leaf(void *user, int i, vec3 x, vec3 n, double acc[3], cut_sta
                          el->n[2] * (x.z - el->c[2])) <= 0)
         return;
     const float *em = &f->light_tree.elem_radiance[3 * (size_t)i];
-    vec3 g = direct_irradiance_rgb(&f->direct, el->prim, x, n, lc->receiver,
-                                   lc->t->light_split);
+    /* (A split point's block shares the pieces: one ray a point already.) */
+    int count = lc->t->light_split
+                    ? f->direct.fallback
+                    : direct_rays_by_share(&f->direct, leaf_share(el, em, x, n, whole));
+    vec3 g = direct_irradiance_rays(&f->direct, el->prim, x, n, lc->receiver,
+                                    lc->t->light_split, count);
     acc[0] += g.x * em[0];
     acc[1] += g.y * em[1];
     acc[2] += g.z * em[2];

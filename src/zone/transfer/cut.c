@@ -343,12 +343,12 @@ typedef struct cut_state {
 
 /* A leaf's elements, exactly. */
 static void take_exactly(gather *g, int32_t left, int32_t count, vec3 x, vec3 n,
-                         const cut_params *c, cut_state *s)
+                         const cut_params *c, cut_state *s, double whole)
 {
     int first = -1 - left;
     for (int i = first; i < first + count; i++) {
         g->st->clusters++;
-        c->leaf(c->user, i, x, n, s->exact, g->st);
+        c->leaf(c->user, i, x, n, whole, s->exact, g->st);
     }
 }
 
@@ -388,7 +388,8 @@ static vec3 refine(gather *g, cut_state *s, vec3 x, vec3 n, const cut_params *c,
         for (int ch = 0; ch < 3; ch++)
             total[ch] -= top.est[ch];
         if (top.count > 0) {
-            take_exactly(g, top.left, top.count, x, n, c, s);
+            take_exactly(g, top.left, top.count, x, n, c, s,
+                         lum(total) + lum(s->exact) + lumf(top.est));
             record(rec, cand_node(&top), CUT_EXACT);
             continue;
         }
@@ -455,7 +456,7 @@ vec3 cut_resume(const sender_tree *t, const rscene *rs, vec3 x, vec3 n, vec3f xo
         const cut_entry *e = &from->e[i];
         const sender_node *node = &t->nodes[e->node];
         if (e->seen == CUT_EXACT) {
-            take_exactly(&g, node->left, node->count, x, n, c, &s);
+            take_exactly(&g, node->left, node->count, x, n, c, &s, 0.0);
             continue;
         }
         cand ch;

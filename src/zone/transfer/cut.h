@@ -19,8 +19,12 @@ typedef struct cut_stats {
     uint64_t capped;    /* cuts stopped by max_cut, not by eps */
 } cut_stats;
 
-/* Adds element i's exact contribution at (x, n) to acc. */
-typedef void (*cut_leaf_fn)(void *user, int i, vec3 x, vec3 n, double acc[3], cut_stats *st);
+/* Adds element i's exact contribution at (x, n) to acc.  whole is the
+ * cut's estimate of the receiver's total when the element is opened (its
+ * luminance; 0 where no estimate is at hand), for a leaf that spends
+ * effort by its share. */
+typedef void (*cut_leaf_fn)(void *user, int i, vec3 x, vec3 n, double whole, double acc[3],
+                            cut_stats *st);
 
 typedef struct cut_params {
     double eps;         /* a cluster may err by this share of the total */

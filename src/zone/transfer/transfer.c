@@ -225,8 +225,9 @@ static void element(gather *g, int i, double acc[3])
     piece(g, q, b, corners, el->background, 0, -1, acc);
 }
 
-static void leaf(void *user, int i, vec3 x, vec3 n, double acc[3], cut_stats *st)
+static void leaf(void *user, int i, vec3 x, vec3 n, double whole, double acc[3], cut_stats *st)
 {
+    (void)whole;
     gather g = {user, x, n, ray_offset(v3_to_f3(x), v3_to_f3(n)), st, {0, 0, 0}, 0};
     element(&g, i, acc);
 }
