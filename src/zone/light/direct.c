@@ -603,13 +603,21 @@ static vec3 split_centre(const vec3 q[3], int levels, int index)
  * light each, and each counts if a ray from x reaches its centre.  A split
  * point (direct.h) takes triangles 4^j times as large and sends its ray to
  * the centre of the sub-piece it names. */
+/* The midpoint levels k that cut a polygon of `fan` fan triangles into
+ * at least `count` pieces (fan x 4^k, at most 4^6 a triangle). */
+static int fan_levels(int fan, int count)
+{
+    int k = 0;
+    while (fan * (1 << (2 * k)) < count && k < 6)
+        k++;
+    return k;
+}
+
 static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, const poly2 *p,
                     vec3 x, vec3 n, int count, int split)
 {
     /* Fan triangles, each cut into 4^k by midpoints. */
-    int fan = p->n - 2, k = 0;
-    while (fan * (1 << (2 * k)) < count && k < 6)
-        k++;
+    int fan = p->n - 2, k = fan_levels(fan, count);
     int levels = DIRECT_SPLIT_LEVELS(split), index = DIRECT_SPLIT_INDEX(split);
     if (levels > k)
         levels = k;
@@ -731,10 +739,13 @@ vec3 direct_irradiance_rays(const direct_ctx *c, int light, vec3 x, vec3 n, int 
     poly2 whole = pieces[0];
     /* Split points are only taken where shadows are busy, and there the
      * search nearly always finds too many: it is skipped (direct.h).  So
-     * is it for a part that takes fewer rays than the fallback's (one of
-     * a light cut into many): a search per part costs as much as tens of
-     * rays, where the parts' rays are one point's budget between them. */
-    int cut = (split > 0 || count < c->fallback) && !clips_every_point(c)
+     * is it for a part whose rays are fewer pieces than the fallback's
+     * (one of a light cut into many): a search per part costs as much as
+     * tens of rays, where the parts' rays are one point's budget between
+     * them. */
+    int fan = whole.n - 2;
+    int fewer = fan_levels(fan, count) < fan_levels(fan, c->fallback);
+    int cut = (split > 0 || fewer) && !clips_every_point(c)
                   ? -1
                   : cut_occluders(c, light, &f, x, n, receiver, &set, &scratch);
     if (cut < 0)

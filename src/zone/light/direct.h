@@ -78,7 +78,10 @@ vec3 direct_irradiance_rgb(const direct_ctx *c, int light, vec3 x, vec3 n, int r
                            int split);
 
 /* The same where the light, if seen by rays, is cut into about `count`
- * triangles instead of the fallback's. */
+ * triangles instead of the fallback's (rounded up to a whole number of
+ * midpoint levels, as the fallback is).  Where that is fewer pieces than
+ * the fallback's, the light is seen by rays without searching for
+ * occluders: no exact clipping. */
 vec3 direct_irradiance_rays(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
                             int split, int count);
 
@@ -87,7 +90,6 @@ vec3 direct_irradiance_rays(const direct_ctx *c, int light, vec3 x, vec3 n, int 
  * receives, at least one, so that a point's rays do not grow with the
  * number of parts its light is cut into. */
 int direct_rays_by_share(const direct_ctx *c, double share);
-
 
 /* The rays this thread's direct-light calls have cast since the last
  * call (they are counted here, as the calls take no zone_trace): the

@@ -474,10 +474,16 @@ static double leaf_share(const sender_elem *el, const float em[3], vec3 x, vec3 
     double r = sqrt(r2);
     double ce = (el->n[0] * w.x + el->n[1] * w.y + el->n[2] * w.z) / r;
     double cr = -v3_dot(n, w) / r;
-    if (ce <= 0 || cr <= 0)
+    if (ce <= 0)
         return 0.0;
-    double lum = 0.2126 * em[0] + 0.7152 * em[1] + 0.0722 * em[2];
-    return lum * el->area * ce * cr / (r2 * whole);
+    if (cr <= 0) {
+        /* The centroid below x's horizon: a part of the element above it
+         * may still be near and bright. */
+        vec3 hi = v3(n.x >= 0 ? el->hi[0] : el->lo[0], n.y >= 0 ? el->hi[1] : el->lo[1],
+                     n.z >= 0 ? el->hi[2] : el->lo[2]);
+        return v3_dot(n, v3_sub(hi, x)) > 0 ? 1.0 : 0.0;
+    }
+    return f3_luminance(f3(em[0], em[1], em[2])) * el->area * ce * cr / (r2 * whole);
 }
 
 /* One light of the light tree, exactly (the side facing x only), with its

@@ -375,6 +375,7 @@ static vec3 refine(gather *g, cut_state *s, vec3 x, vec3 n, const cut_params *c,
             break;
         }
         cand top = heap_pop(heap, &s->hn);
+        double whole = lum(total) + lum(s->exact);
         /* The next clusters to open are near the heap's top: their
          * children's records, from anywhere in the tree, are fetched while
          * this one's are weighed. */
@@ -388,8 +389,7 @@ static vec3 refine(gather *g, cut_state *s, vec3 x, vec3 n, const cut_params *c,
         for (int ch = 0; ch < 3; ch++)
             total[ch] -= top.est[ch];
         if (top.count > 0) {
-            take_exactly(g, top.left, top.count, x, n, c, s,
-                         lum(total) + lum(s->exact) + lumf(top.est));
+            take_exactly(g, top.left, top.count, x, n, c, s, whole);
             record(rec, cand_node(&top), CUT_EXACT);
             continue;
         }
