@@ -598,11 +598,6 @@ static vec3 split_centre(const vec3 q[3], int levels, int index)
     return v3_scale(v3_add(v3_add(a, b), c), 1.0 / 3.0);
 }
 
-/* The irradiance of polygon piece p (on the light's plane) at x, with
- * visibility by rays: p is cut into triangles of about 1/count of the
- * light each, and each counts if a ray from x reaches its centre.  A split
- * point (direct.h) takes triangles 4^j times as large and sends its ray to
- * the centre of the sub-piece it names. */
 /* The midpoint levels k that cut a polygon of `fan` fan triangles into
  * at least `count` pieces (fan x 4^k, at most 4^6 a triangle). */
 static int fan_levels(int fan, int count)
@@ -613,6 +608,11 @@ static int fan_levels(int fan, int count)
     return k;
 }
 
+/* The irradiance of polygon piece p (on the light's plane) at x, with
+ * visibility by rays: p is cut into triangles of about 1/count of the
+ * light each, and each counts if a ray from x reaches its centre.  A split
+ * point (direct.h) takes triangles 4^j times as large and sends its ray to
+ * the centre of the sub-piece it names. */
 static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, const poly2 *p,
                     vec3 x, vec3 n, int count, int split)
 {
