@@ -611,6 +611,58 @@ static void test_camera_moves_without_phase_one(void **state)
 }
 
 /* The command line: --save-forest, --load-forest, -v statistics. */
+/* Phase Two's time split (zt_render_stats): every pixel counted once, by
+ * the kind its samples say, and no more thread-seconds than the threads
+ * had in Phase Two. */
+static void check_split(const zt_render_stats *st, int pixels, int threads, int shaded)
+{
+    uint64_t all = 0;
+    double spent = st->p2_lists_seconds + st->p2_records_seconds;
+    for (int k = 0; k < ZT_PIXEL_KINDS; k++) {
+        all += st->p2_pixels[k];
+        spent += st->p2_shade_seconds[k];
+        assert_true(st->p2_shade_seconds[k] >= 0.0);
+        assert_true(st->p2_samples[k] >= st->p2_pixels[k]);
+    }
+    assert_int_equal(all, shaded ? (uint64_t)pixels : 0);
+    assert_true(st->p2_lists_seconds > 0.0);
+    assert_true(spent <= threads * st->phase_two_seconds + 1e-9);
+    /* The kinds' sample counts are the design's (quality 0: one sample on
+     * a smooth surface). */
+    assert_int_equal(st->p2_samples[ZT_PIXEL_ONE], st->p2_pixels[ZT_PIXEL_ONE]);
+    assert_int_equal(st->p2_samples[ZT_PIXEL_CURVED], 4 * st->p2_pixels[ZT_PIXEL_CURVED]);
+    assert_int_equal(st->p2_samples[ZT_PIXEL_DETAIL], 64 * st->p2_pixels[ZT_PIXEL_DETAIL]);
+    assert_int_equal(st->p2_samples[ZT_PIXEL_SHADOW], 4 * st->p2_pixels[ZT_PIXEL_SHADOW]);
+}
+
+static void test_phase_two_split(void **state)
+{
+    (void)state;
+    zt_scene *s = scene_from(mesh_box_text());
+    zt_render_options o = zone_options(2, 2);
+    zt_render_stats st;
+    zt_image *img = render(s, &o, &st);
+    check_split(&st, 20 * 16, 2, 1);
+    print_message("split: one %llu, detail %llu, shadow %llu, edge %llu, fine %llu pixels\n",
+                  (unsigned long long)st.p2_pixels[ZT_PIXEL_ONE],
+                  (unsigned long long)st.p2_pixels[ZT_PIXEL_DETAIL],
+                  (unsigned long long)st.p2_pixels[ZT_PIXEL_SHADOW],
+                  (unsigned long long)st.p2_pixels[ZT_PIXEL_EDGE],
+                  (unsigned long long)st.p2_pixels[ZT_PIXEL_FINE]);
+    /* The box's walls meet along edges; the slats are a mesh. */
+    assert_true(st.p2_pixels[ZT_PIXEL_ONE] > 0);
+    assert_true(st.p2_pixels[ZT_PIXEL_EDGE] > 0);
+    assert_true(st.p2_records_seconds > 0.0);
+    zt_image_release(img);
+    /* The zone strategy finds the same samples but shades zone by zone:
+     * its shading is not split. */
+    o.strategy = ZT_STRATEGY_ZONE;
+    img = render(s, &o, &st);
+    check_split(&st, 20 * 16, 2, 0);
+    zt_image_release(img);
+    zt_scene_release(s);
+}
+
 static void test_cli(void **state)
 {
     (void)state;
@@ -665,6 +717,7 @@ int main(void)
         cmocka_unit_test(test_crossings),
         cmocka_unit_test(test_forest_rejections),
         cmocka_unit_test(test_camera_moves_without_phase_one),
+        cmocka_unit_test(test_phase_two_split),
         cmocka_unit_test(test_cli),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

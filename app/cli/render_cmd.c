@@ -154,6 +154,29 @@ static int output_writable(const char *path)
     return cli_can_replace(path, "");
 }
 
+/* Where Phase Two's time went, in thread-seconds (-v). */
+static void print_phase_two_split(const zt_render_stats *s)
+{
+    static const char *const kind[ZT_PIXEL_KINDS] = {
+        "one surface", "curved 2x2", "mesh detail 8x8", "busy shadow 2x2", "edge", "fine edge"};
+    double shaded = 0;
+    for (int k = 0; k < ZT_PIXEL_KINDS; k++)
+        shaded += s->p2_shade_seconds[k];
+    double all = s->p2_lists_seconds + s->p2_records_seconds + shaded;
+    if (!(all > 0))
+        return;
+    fprintf(stderr, "phase two split (thread-seconds): %.3f s: samples found %.3f (%.0f%%), "
+                    "gathers at pixel centres %.3f (%.0f%%), shading %.3f (%.0f%%)\n",
+            all, s->p2_lists_seconds, 100 * s->p2_lists_seconds / all, s->p2_records_seconds,
+            100 * s->p2_records_seconds / all, shaded, 100 * shaded / all);
+    for (int k = 0; k < ZT_PIXEL_KINDS; k++)
+        if (s->p2_pixels[k])
+            fprintf(stderr, "  shading %-16s %8llu pixels %9llu samples %8.3f s (%.0f%%)\n",
+                    kind[k], (unsigned long long)s->p2_pixels[k],
+                    (unsigned long long)s->p2_samples[k], s->p2_shade_seconds[k],
+                    100 * s->p2_shade_seconds[k] / all);
+}
+
 /* The zone tracer's forest figures and phase times (-v). */
 static void print_zone_stats(const zt_render_stats *s, const char *loaded_from)
 {
@@ -182,6 +205,7 @@ static void print_zone_stats(const zt_render_stats *s, const char *loaded_from)
     else
         fprintf(stderr, "phase one: %.3f s; phase two: %.3f s\n", s->phase_one_seconds,
                 s->phase_two_seconds);
+    print_phase_two_split(s);
 }
 
 /* zt_render, keeping the renderer long enough to save its forest (written

@@ -133,6 +133,18 @@ typedef enum zt_stop_reason {
     ZT_STOP_INTERRUPT = 2  /* options.stop */
 } zt_stop_reason;
 
+/* How the zone tracer's Phase Two sampled a pixel (docs/zone-tracer.md,
+ * "Phase Two"), for its time split in zt_render_stats. */
+typedef enum zt_pixel_kind {
+    ZT_PIXEL_ONE = 0,  /* one smooth surface: the quality's g x g samples */
+    ZT_PIXEL_CURVED,   /* a sphere on the way: 2 x 2 */
+    ZT_PIXEL_DETAIL,   /* a mesh's sub-pixel detail: 8 x 8 sharing one point's rays */
+    ZT_PIXEL_SHADOW,   /* a busy shadow: 2 x 2 sharing one point's rays */
+    ZT_PIXEL_EDGE,     /* an edge: coverage grid, its groups shaded on a subset */
+    ZT_PIXEL_FINE,     /* a light's image in a mirror or glass: the fine grid */
+    ZT_PIXEL_KINDS
+} zt_pixel_kind;
+
 typedef struct zt_render_stats {
     double seconds;        /* wall time of the whole render */
     double trace_seconds;  /* of which rendering the image itself (the rest
@@ -161,6 +173,17 @@ typedef struct zt_render_stats {
                               aims at (docs/zone-tracer.md) */
     int forest_loaded;     /* zone: the forest came from options.forest_file
                               (phase_one_seconds is then the time to read it) */
+    /* zone, Phase Two's time split in thread-seconds (the sum over threads
+     * of the time each spent there; this process's share of the image):
+     * finding every pixel's samples, the gathers at pixel centres on
+     * meshes, and shading the pixels of each kind (the pixel strategy
+     * only; the zone strategy's shading is not split), with how many
+     * pixels and samples each kind had. */
+    double p2_lists_seconds;
+    double p2_records_seconds;
+    double p2_shade_seconds[ZT_PIXEL_KINDS];
+    uint64_t p2_pixels[ZT_PIXEL_KINDS];
+    uint64_t p2_samples[ZT_PIXEL_KINDS];
     /* zt_render */
     int spp_done;          /* path: samples per pixel in the image */
     int spp_resumed;       /* path: of which read from the checkpoint */

@@ -99,6 +99,9 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
     double t0 = render_clock();
     p2_ctx c;
     p2_ctx_begin(&c, r);
+    p2_split split;
+    memset(&split, 0, sizeof split);
+    c.split = &split;
     zt_status st = p2_terms_build(&c.terms, f, r, c.lo, c.hi, err);
     p2_marks marks = {NULL, NULL, NULL, 0, 0};
     if (st == ZT_OK && !p2_marks_build(&marks, &c))
@@ -149,6 +152,13 @@ static zt_status phase_two(zt_renderer *r, zt_image *sum, zt_render_stats *stats
         /* Phase One is charged to the first image of the renderer only. */
         stats->phase_one_seconds = f->images == 0 ? f->phase_one_seconds : 0.0;
         stats->phase_two_seconds = render_clock() - t0;
+        stats->p2_lists_seconds = split.lists;
+        stats->p2_records_seconds = split.records;
+        for (int k = 0; k < ZT_PIXEL_KINDS; k++) {
+            stats->p2_shade_seconds[k] = split.shade[k];
+            stats->p2_pixels[k] = split.pixels[k];
+            stats->p2_samples[k] = split.samples[k];
+        }
         fill_forest_stats(f, r, stats);
     }
     if (st == ZT_OK && !reference)

@@ -121,15 +121,22 @@ zt_status p2_gather_cache_build(struct zone_gather_cache *gc, const p2_ctx *c, u
             failed = 1;
         else
             t.memo->pixel = UINT32_MAX;
+        double spent = 0;
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < h; y++) {
             if (failed || !share_owns(o, y))
                 continue;
+            double t0 = render_clock();
             for (int x = 0; x < w; x++)
                 record_at(c, &t, gc, x, y);
+            spent += render_clock() - t0;
         }
         free(t.memo);
         rays += t.rays;
+        if (c->split) {
+#pragma omp atomic
+            c->split->records += spent;
+        }
     }
     *rays_out += rays;
     zt_status st = failed ? zt_fail(err, ZT_ERR_MEMORY, "out of memory for the pixels' gathers")

@@ -65,8 +65,16 @@ typedef struct p2_row {
     uint32_t *corner;           /* scratch: corner signatures */
     int *corner_part;
     float *corner_t;            /* their first hits' distances (-1: none) */
+    uint8_t *kind;              /* each pixel's zt_pixel_kind */
     int width;
 } p2_row;
+
+/* Phase Two's time split (zt_render_stats), in thread-seconds: each
+ * thread adds its own once it is done. */
+typedef struct p2_split {
+    double lists, records, shade[ZT_PIXEL_KINDS];
+    uint64_t pixels[ZT_PIXEL_KINDS], samples[ZT_PIXEL_KINDS];
+} p2_split;
 
 /* What a term needs to know about one pixel. */
 typedef struct p2_pixel {
@@ -76,6 +84,7 @@ typedef struct p2_pixel {
     const int *lights;
     const double *light_cover;  /* measured coverage of each, or -1 */
     int nlights;
+    int kind;                   /* zt_pixel_kind: how it was sampled */
 } p2_pixel;
 
 typedef enum p2_term_type {
@@ -119,6 +128,7 @@ typedef struct p2_ctx {
     p2_terms terms;
     const struct p2_marks *marks; /* what the pixels' own rays may miss */
     const struct zone_gather_cache *cache; /* gathers at pixel centres */
+    p2_split *split;    /* where the time goes; NULL: not measured */
 } p2_ctx;
 
 /* What the pixels' own rays may miss, found from the eye
@@ -155,6 +165,7 @@ static inline void p2_row_pixel(const p2_row *row, int x, int y, p2_pixel *px)
     px->lights = row->lights ? row->lights + row->light_first[x] : NULL;
     px->light_cover = row->light_cover ? row->light_cover + row->light_first[x] : NULL;
     px->nlights = (int)(row->light_first[x + 1] - row->light_first[x]);
+    px->kind = row->kind[x];
 }
 
 /* The first hit of a camera sample, as zone_radiance sees it. */

@@ -90,6 +90,23 @@ static int pixel_terms(const p2_ctx *c, const p2_pixel *px, int **list, int *cap
     return n;
 }
 
+/* A thread's time split, added to the context's once it is done. */
+static void split_add(const p2_ctx *c, const p2_split *own)
+{
+    if (!c->split)
+        return;
+#pragma omp critical(p2_split)
+    {
+        c->split->lists += own->lists;
+        c->split->records += own->records;
+        for (int k = 0; k < ZT_PIXEL_KINDS; k++) {
+            c->split->shade[k] += own->shade[k];
+            c->split->pixels[k] += own->pixels[k];
+            c->split->samples[k] += own->samples[k];
+        }
+    }
+}
+
 zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt_error *err)
 {
     const zt_render_options *o = &c->r->options;
@@ -109,14 +126,18 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
         p2_row row;
         memset(&row, 0, sizeof row);
         int *list = NULL, cap = 0;
+        p2_split own = {0};
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < sum->height; y++) {
             if (prog.cancelled || failed || !share_owns(o, y))
                 continue;
+            double t0 = render_clock();
             if (!p2_row_build(c, y, &row, &t.rays)) {
                 failed = 1;
                 continue;
             }
+            double t1 = render_clock();
+            own.lists += t1 - t0;
             for (int x = 0; x < sum->width && !failed; x++) {
                 p2_pixel px;
                 p2_row_pixel(&row, x, y, &px);
@@ -129,6 +150,11 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
                 for (int k = 0; k < n; k++)
                     p2_apply(c, &t, list[k], &px, acc);
                 add_to_image(sum, x, y, acc);
+                double t2 = render_clock();
+                own.shade[px.kind] += t2 - t1;
+                own.pixels[px.kind]++;
+                own.samples[px.kind] += (uint64_t)px.n;
+                t1 = t2;
             }
             t.rays += direct_rays_take();
             progress_add(&prog, 1.0);
@@ -137,6 +163,7 @@ zt_status p2_render_pixels(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, z
         free(t.memo);
         p2_row_free(&row);
         rays += t.rays;
+        split_add(c, &own);
     }
     *rays_out += rays;
     if (failed)
@@ -211,15 +238,19 @@ zt_status p2_render_zones(const p2_ctx *c, zt_image *sum, uint64_t *rays_out, zt
 #pragma omp parallel num_threads(threads) reduction(+ : rays)
     {
         uint64_t r = 0;
+        p2_split own = {0};
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < h; y++) {
             if (prog.cancelled || failed || !share_owns(o, y))
                 continue;
+            double t0 = render_clock();
             if (!p2_row_build(c, y, &rows[y], &r))
                 failed = 1;
+            own.lists += render_clock() - t0;
             progress_add(&prog, 1.0);
         }
         rays += r;
+        split_add(c, &own);
     }
     if (failed) {
         st = zt_fail(err, ZT_ERR_MEMORY, "out of memory in Phase Two");

@@ -555,6 +555,7 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
                          const float ct[4], const int cp[4], seen_lights *lights, p2_row *row,
                          edge_grid **scratch, uint64_t *rays)
 {
+    row->kind[px] = ZT_PIXEL_ONE;
     int g = c->g;
     uint32_t first = corners[0];
     int edge = corners[1] != first || corners[2] != first || corners[3] != first ||
@@ -583,12 +584,14 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
          * refraction, shading over a curved surface) changes within it
          * faster than one sample can tell. */
         row->sample_count = start;
+        row->kind[px] = ZT_PIXEL_CURVED;
         if (!grid_samples(c, px, py, CURVED_GRID, 0, first, lights, row, rays, &edge, &curved))
             return 0;
     }
     if (!edge && !marked && g < DETAIL_GRID &&
         fine_detail(c, ct, cp, row->samples + start, row->sample_count - start)) {
         row->sample_count = start;
+        row->kind[px] = ZT_PIXEL_DETAIL;
         if (!grid_samples(c, px, py, DETAIL_GRID, DETAIL_SPLIT, first, lights, row, rays, &edge,
                           &curved))
             return 0;
@@ -596,12 +599,14 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
     if (!edge && !marked && g == 1 && row->sample_count - start == 1 &&
         busy_shadow(c, &row->samples[start])) {
         row->sample_count = start;
+        row->kind[px] = ZT_PIXEL_SHADOW;
         if (!grid_samples(c, px, py, 2, 1, first, lights, row, rays, &edge, &curved))
             return 0;
     }
     if (!edge && !marked)
         return 1;
     row->sample_count = start;
+    row->kind[px] = ZT_PIXEL_EDGE;
 
     if (!*scratch && !(*scratch = malloc(sizeof(edge_grid))))
         return 0;
@@ -618,6 +623,7 @@ static int pixel_samples(const p2_ctx *c, int px, int py, const uint32_t corners
          * outlines the sphere by a polygon, the grid by rays; the two would
          * leave slivers between them, so both come from the fine grid. */
         row->sample_count = start;
+        row->kind[px] = ZT_PIXEL_FINE;
         if (!edge_samples(c, px, py, FINE_GRID, FINE_SHADE, *scratch, lights, row, rays, &glint,
                           &rim, rim))
             return 0;
@@ -636,8 +642,9 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
         row->corner = malloc(2 * (size_t)w1 * sizeof *row->corner);
         row->corner_part = malloc(2 * (size_t)w1 * sizeof *row->corner_part);
         row->corner_t = malloc(2 * (size_t)w1 * sizeof *row->corner_t);
+        row->kind = malloc((size_t)w);
         if (!row->pixel_first || !row->light_first || !row->corner || !row->corner_part ||
-            !row->corner_t)
+            !row->corner_t || !row->kind)
             return 0;
     }
     row->sample_count = 0;
@@ -696,5 +703,6 @@ void p2_row_free(p2_row *row)
     free(row->corner);
     free(row->corner_part);
     free(row->corner_t);
+    free(row->kind);
     memset(row, 0, sizeof *row);
 }
