@@ -199,6 +199,11 @@ typedef struct zone_gather_slot {
     uint16_t sample, samples; /* its place among all of the pixel's samples
                                  (an edge pixel's too): rough lobes share
                                  the pixel's stretch by it (rough.c) */
+    /* A sample shaded for the 2 x 2 block of a grid `block_width` wide
+     * whose first (top left) is sample block_first: it takes the four's
+     * directions (gather.c).  block_width 0: itself alone. */
+    uint16_t block_first;
+    uint8_t block_width;
 } zone_gather_slot;
 
 typedef struct zone_trace {

@@ -67,7 +67,13 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
 /* A split's levels j and point i (0 for split 0), and its sky's levels. */
 #define DIRECT_SPLIT_LEVELS(split) (((split) >> 16) & 0xf)
 #define DIRECT_SPLIT_SKY_LEVELS(split)                                                              \
-    (((split) >> 20) ? ((split) >> 20) - 1 : DIRECT_SPLIT_LEVELS(split))
+    ((((split) >> 20) & 0xf) ? (((split) >> 20) & 0xf) - 1 : DIRECT_SPLIT_LEVELS(split))
+/* A split point that stands for the 2 x 2 block of points a level finer
+ * (a mesh detail pixel's block on one facet, samples.c): its pieces of a
+ * light are those four's between them already (each of its pieces is cut
+ * into the four's sub-pieces, lowest digit first); its sky directions are
+ * the four's (phase_one.c). */
+#define DIRECT_SPLIT_BLOCK (1 << 24)
 #define DIRECT_SPLIT_INDEX(split) ((split) ? ((split) & 0xffff) - 1 : 0)
 double direct_irradiance_split(const direct_ctx *c, int light, vec3 x, vec3 n, int receiver,
                                int split);

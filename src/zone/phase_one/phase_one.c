@@ -62,23 +62,40 @@ static vec3 sky_open_irradiance(const zone_forest *f, vec3f n)
 }
 
 /* The directions of `count` that a point takes: all of them, or for a
- * split point (direct.h) every stride-th from its own first, so that the
- * block's points take them all between them, each direction once, for one
- * point's rays (points `stride` apart share when the block outnumbers
- * them).  Which directions a point takes follows its place in the block,
- * as its pieces of a light do. */
-static void sky_share(int split, int count, int *first, int *stride)
+ * split point (direct.h) those whose index modulo `stride` is within
+ * `width` of its `first`, so that the block's points take them all
+ * between them, each direction once, for one point's rays (points
+ * `stride` apart share when the block outnumbers them).  Which directions
+ * a point takes follows its place in the block, as its pieces of a light
+ * do; a point that stands for the 2 x 2 block of points a level finer
+ * (DIRECT_SPLIT_BLOCK) takes the four's. */
+typedef struct sky_part {
+    int first, stride, width;
+} sky_part;
+
+static sky_part sky_share(int split, int count)
 {
-    *first = 0;
-    *stride = 1;
+    sky_part p = {0, 1, 1};
     if (!split)
-        return;
-    int levels = DIRECT_SPLIT_SKY_LEVELS(split), index = DIRECT_SPLIT_INDEX(split);
-    int s = 1;
-    while (levels-- > 0 && s * 4 <= count)
-        s *= 4;
-    *first = index % s;
-    *stride = s;
+        return p;
+    int block = (split & DIRECT_SPLIT_BLOCK) != 0;
+    int levels = DIRECT_SPLIT_SKY_LEVELS(split) + block;
+    int index = DIRECT_SPLIT_INDEX(split) << (2 * block);
+    while (levels-- > 0 && p.stride * 4 <= count)
+        p.stride *= 4;
+    p.first = index % p.stride;
+    p.width = block && p.stride >= 4 ? 4 : 1;
+    if (block && p.stride < 4) {
+        p.first = 0;
+        p.width = p.stride;
+    }
+    return p;
+}
+
+static int sky_takes(const sky_part *p, int k)
+{
+    int r = k % p->stride - p->first;
+    return r >= 0 && r < p->width;
 }
 
 /* The share of the gather's count that a point aims at portals. */
@@ -92,15 +109,15 @@ static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
 {
     const zone_forest *f = t->f;
     const rscene *rs = &t->r->rs;
-    int total = 0, first, stride;
+    int total = 0;
     for (int i = 0; i < count; i++)
         total += picks[i].count;
-    sky_share(t->light_split, total, &first, &stride);
+    sky_part share = sky_share(t->light_split, total);
     vec3 e = v3(0, 0, 0);
     int k = 0;
     for (int i = 0; i < count; i++) {
         for (int j = 0; j < picks[i].count; j++, k++) {
-            if (k % stride != first)
+            if (!sky_takes(&share, k))
                 continue;
             vec3 d;
             double share = sky_portal_view_direction(&picks[i].view, j, picks[i].count, &d);
@@ -117,7 +134,7 @@ static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
             e = v3_add(e, v3_scale(f3_to_v3(f3_mul(l, tr)), share * c));
         }
     }
-    return v3_scale(e, stride);
+    return v3_scale(e, (double)share.stride / share.width);
 }
 
 /* Whether the gather's ray along d reaches the sky, and with what: 0 when
@@ -141,7 +158,6 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 {
     const zone_forest *f = t->f;
     const rscene *rs = &t->r->rs;
-    int first, stride;
     vec3f nf = v3_to_f3(n), o = ray_offset(v3_to_f3(x), nf);
     sky_portal_pick picks[SKY_PORTAL_PICKS_MAX];
     int picked = f->portals.count
@@ -155,13 +171,13 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
          * the share's whole is taken over every direction, which costs no
          * ray). */
         vec3f seen = f3_splat(0.0f), all = f3_splat(0.0f);
-        sky_share(t->light_split, f->sky_dir_count, &first, &stride);
+        sky_part share = sky_share(t->light_split, f->sky_dir_count);
         for (int k = 0; k < f->sky_dir_count; k++) {
             float c = f3_dot(nf, f->sky_dirs[k]);
             if (c <= 0.0f)
                 continue;
             all = f3_madd(all, f->sky_weight[k], c);
-            if (k % stride != first)
+            if (!sky_takes(&share, k))
                 continue;
             vec3f tr = sky_gather_ray(t, o, f->sky_dirs[k], picks, picked);
             if (!f3_is_black(tr))
@@ -169,7 +185,7 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
         }
         /* A split point's share of the directions stands for all of them:
          * the block's points together see what one point's would. */
-        seen = f3_scale(seen, (float)stride);
+        seen = f3_scale(seen, (float)share.stride / (float)share.width);
         vec3 open = sky_open_irradiance(f, nf);
         return v3_add(portals, v3(all.x > 0.0f ? open.x * seen.x / all.x : open.x,
                                   all.y > 0.0f ? open.y * seen.y / all.y : open.y,
@@ -178,9 +194,11 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
     vec3 tt, bb;
     v3_frame(n, &tt, &bb);
     vec3f open = f3_splat(0.0f);
-    sky_share(t->light_split, f->q.gather, &first, &stride);
+    sky_part share = sky_share(t->light_split, f->q.gather);
     int taken = 0;
-    for (int k = first; k < f->q.gather; k += stride) {
+    for (int k = share.first; k < f->q.gather; k++) {
+        if (!sky_takes(&share, k))
+            continue;
         const vec3 *dk = &f->dirs[k];
         vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
         open = f3_add(open, sky_gather_ray(t, o, v3_to_f3(d), picks, picked));

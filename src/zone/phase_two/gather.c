@@ -68,13 +68,28 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
     /* Only a camera sample's own gather keeps its hits (samples > 0): a
      * rough lobe's or a coat's direction that meets a mesh gathers there
      * too, and would take sample 0's room. */
-    if (memo && slot.samples > 0 && slot.sample < ZONE_MEMO_SAMPLES &&
-        ((size_t)slot.sample + 1) * (size_t)k_max <= ZONE_MEMO_HITS) {
+    /* A sample shaded for a 2 x 2 block (samples.c) takes the four
+     * samples' directions, and keeps their hits where theirs would be: the
+     * pixel's other samples are elsewhere. */
+    int members = slot.block_width ? 4 : 1;
+    /* Each member's place in the pixel's stretch and its room in the memo
+     * (a detail pixel's samples are numbered alike in both). */
+    int member[4] = {index, 0, 0, 0}, room[4] = {slot.sample, 0, 0, 0};
+    if (slot.block_width) {
+        member[0] = slot.block_first;
+        member[1] = slot.block_first + 1;
+        member[2] = slot.block_first + slot.block_width;
+        member[3] = slot.block_first + slot.block_width + 1;
+        memcpy(room, member, sizeof room);
+    }
+    int top = room[members - 1] > room[0] ? room[members - 1] : room[0];
+    if (memo && slot.samples > 0 && top < ZONE_MEMO_SAMPLES &&
+        ((size_t)top + 1) * (size_t)k_max <= ZONE_MEMO_HITS) {
         if (memo->pixel != slot.pixel) {
             memo->pixel = slot.pixel;
             memset(memo->have, 0, sizeof memo->have);
         }
-        kept = memo->hits + (size_t)slot.sample * k_max;
+        kept = memo->hits;
         vec3f was = memo->origin[slot.sample];
         reuse = memo->have[slot.sample] && was.x == o.x && was.y == o.y && was.z == o.z;
         memo->have[slot.sample] = 1;
@@ -82,9 +97,10 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
     }
     vec3 sum = v3(0, 0, 0);
     double inv_sum = 0;
-    for (int k = 0; k < k_max; k++) {
+    for (int j = 0; j < members * k_max; j++) {
+        int k = j % k_max;
         double u, v;
-        r2_point(first + (double)count * k, &u, &v);
+        r2_point(first - index + member[j / k_max] + (double)count * k, &u, &v);
         const float uv[2] = {(float)u, (float)v};
         vec3f d = bsdf_cosine_hemisphere(&frame, uv);
         /* Below the geometric surface (a shading normal tilts the frame):
@@ -94,7 +110,7 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
         d = f3_normalize(d);
         hit own;
         if (kept || inv_dist) {
-            hit *h = kept ? &kept[k] : &own;
+            hit *h = kept ? &kept[(size_t)room[j / k_max] * k_max + k] : &own;
             if (!kept || !reuse) {
                 *h = accel_intersect(&t->r->rs, o, d);
                 t->rays++;
@@ -110,8 +126,8 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
     t->gather = slot;
     t->sample_share = share;
     if (inv_dist)
-        *inv_dist = inv_sum / k_max;
-    return v3_scale(sum, 3.14159265358979 / k_max);
+        *inv_dist = inv_sum / (members * k_max);
+    return v3_scale(sum, 3.14159265358979 / (members * k_max));
 }
 
 vec3 zone_mesh_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level, int prim,

@@ -62,7 +62,7 @@ static void record_at(const p2_ctx *c, zone_trace *t, struct zone_gather_cache *
     if (sf.m->weight[LOBE_DIFFUSE] <= 0.0f || sf.m->is_light)
         return;
     /* The directions the pixel's one sample would take. */
-    t->gather = (zone_gather_slot){(uint32_t)i, 0, 1, 0, 1};
+    t->gather = (zone_gather_slot){.pixel = (uint32_t)i, .count = 1, .samples = 1};
     double inv_dist = 0;
     for (int k = 0; k < gc->levels; k++) {
         double id;

@@ -407,7 +407,8 @@ vec3 zone_rough_radiance(zone_trace *t, const zone_rough_at *s, unsigned lobes, 
     for (int k = 0; k < k_max && lo <= hi; k++) {
         double j = sq.first + sq.step * k;
         if (camera) {
-            t->gather = (zone_gather_slot){slot.pixel, (uint16_t)k, (uint16_t)k_max, 0, 0};
+            t->gather = (zone_gather_slot){
+                .pixel = slot.pixel, .index = (uint16_t)k, .count = (uint16_t)k_max};
             t->rough_nested = 1;
             t->rough_j = j;
         }
