@@ -420,6 +420,7 @@ typedef struct edge_grid {
     hit hits[FINE_GRID * FINE_GRID];
     int group_of[FINE_GRID * FINE_GRID], group_count[FINE_GRID * FINE_GRID];
     int group_shaded[FINE_GRID * FINE_GRID];
+    int group_next[FINE_GRID * FINE_GRID]; /* the next shaded point's ordinal */
     vec3f group_n[FINE_GRID * FINE_GRID]; /* a mesh group's facing (else 0) */
 } edge_grid;
 
@@ -462,10 +463,10 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
     const int cells = n * n, quasi = c->f->q.cover_quasi;
     /* A mesh's group is shaded as a detail pixel is (its own sub-pixel
      * detail shows no edge, as a shadow across a sunlit sill): on the 8 x 8
-     * subset, its points sharing one point's light rays.  A group may hold
-     * few of the 64, so its sky and its gathers are shared by 2 x 2 blocks
-     * only: each point takes a quarter of a point's directions, and reads
-     * the pixels' gather records as the 4 x 4 subset's points do. */
+     * subset, its points sharing one point's light rays and sky directions
+     * (by their ordinal in the group, below).  Its gathers are shared by
+     * 2 x 2 blocks only, reading the pixels' gather records as the 4 x 4
+     * subset's points do. */
     const int mesh_shade =
         shade < DETAIL_GRID && (quasi || n % DETAIL_GRID == 0) ? DETAIL_GRID : shade;
     int groups = 0;
@@ -502,6 +503,7 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
             e->group_sig[k] = e->sig[i];
             e->group_count[k] = 0;
             e->group_shaded[k] = 0;
+            e->group_next[k] = 0;
             e->group_n[k] = ng;
             groups++;
         }
@@ -535,7 +537,15 @@ static int edge_samples(const p2_ctx *c, int px, int py, int n, int shade, edge_
             int sx = quasi ? i % DETAIL_GRID : i % n / step;
             int sy = quasi ? i / DETAIL_GRID : i / n / step;
             int place = split_index(sx, sy, DETAIL_SPLIT);
-            ls = DIRECT_SPLIT_SKY(DETAIL_SPLIT, 1, place);
+            /* The group's points in turn (ordinal o of its m) take the
+             * light's pieces and the sky's directions that points 0..m-1
+             * of a block take: the group as a whole sees one point's
+             * directions, whatever part of the pixel it covers, each
+             * point 1/4^k of them (4^k <= m; points 4^k apart share). */
+            int m = e->group_shaded[k], o = e->group_next[k]++, sky = 0;
+            while (sky < DETAIL_SPLIT && (4 << (2 * sky)) <= m)
+                sky++;
+            ls = DIRECT_SPLIT_SKY(DETAIL_SPLIT, sky, o);
             slot = gather_slot(c, px, py, place % 4, 4);
         }
         if (!push_sample(rs, row, org, dir, e->hits[i], w, ls, slot))
