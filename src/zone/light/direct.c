@@ -612,52 +612,78 @@ static int fan_levels(int fan, int count)
  * visibility by rays: p is cut into triangles of about 1/count of the
  * light each, and each counts if a ray from x reaches its centre.  A split
  * point (direct.h) takes triangles 4^j times as large and sends its ray to
- * the centre of the sub-piece it names. */
+ * the centre of the sub-piece it names.  When the block has more points
+ * than that leaves levels to cut (a polygon of many sides, the sun's or a
+ * sphere light's disc, whose fan already has about `count` triangles), the
+ * block's points also share the fan's triangles: each takes every s-th of
+ * them, s = what is left of the block, and weighs what it sees by s, so
+ * that a block of 64 points sees the disc's triangles between them for one
+ * point's rays instead of each point all of them (on the IFC house at the
+ * default quality, every edge sample cast 30 rays at the sun). */
 static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, const poly2 *p,
                     vec3 x, vec3 n, int count, int split)
 {
     /* Fan triangles, each cut into 4^k by midpoints. */
     int fan = p->n - 2, k = fan_levels(fan, count);
     int levels = DIRECT_SPLIT_LEVELS(split), index = DIRECT_SPLIT_INDEX(split);
-    if (levels > k)
-        levels = k;
+    if ((split & DIRECT_SPLIT_BLOCK) && levels + 1 > k) {
+        /* A point standing for four a level finer, which share the fan's
+         * triangles: their rays, one after the other. */
+        vec3 e = v3(0, 0, 0);
+        for (int d = 0; d < 4; d++)
+            e = v3_add(e, by_rays(c, lp, f, p, x, n, count,
+                                  DIRECT_SPLIT(levels + 1, 4 * index + d)));
+        return v3_scale(e, 0.25);
+    }
+    int used = levels > k ? k : levels;
+    int share = 1, offset = 0;
+    if (levels > used) {
+        int rest = 1 << (2 * (levels - used));
+        share = rest < fan ? rest : fan;
+        offset = ((index >> (2 * used)) % rest) % share;
+    }
+    levels = used;
     k -= levels;
-    int m = 1 << k, pieces = fan * m * m;
+    int m = 1 << k, per_fan = m * m, pieces = fan * per_fan;
     vec3f xo = ray_offset(v3_to_f3(x), v3_to_f3(n));
     /* First every piece's ray; then Lambert's formula over the seen pieces
      * or, when most are seen, over the whole polygon less the hidden ones:
      * the formula costs more than a ray, and most points see all or none.
-     * A ray's result is 1 or 0, or by colour what panes let through. */
+     * A ray's result is 1 or 0, or by colour what panes let through.  A
+     * point that takes every share-th fan triangle weighs each by share. */
     vec3f seen[BY_RAYS_KEPT];
-    int keep = pieces <= BY_RAYS_KEPT, at = 0;
+    int keep = pieces <= BY_RAYS_KEPT, at = 0, taken = 0;
     double seen_count = 0;
     vec3 e = v3(0, 0, 0);
     fan_walk w;
     vec3 q[3];
     fan_start(&w, f, p, m);
-    while (fan_next(&w, q)) {
-        vec3 ctr = split_centre(q, levels, index);
-        vec3f to = f3_sub(v3_to_f3(ctr), xo);
-        float dist = f3_length(to);
+    for (int g = 0; fan_next(&w, q); g++) {
         vec3f s = f3_splat(0.0f);
-        if (dist > 0.0f) {
-            vec3f d = f3_scale(to, 1.0f / dist);
-            if (lp->shape == SHAPE_SPHERE)
-                dist = sphere_entry(lp, xo, d, dist);
-            s = accel_transmittance(c->rs, xo, d, dist * 0.9999f, lp->background);
-            rays_cast++;
+        if ((g / per_fan) % share == offset) {
+            taken++;
+            vec3 ctr = split_centre(q, levels, index);
+            vec3f to = f3_sub(v3_to_f3(ctr), xo);
+            float dist = f3_length(to);
+            if (dist > 0.0f) {
+                vec3f d = f3_scale(to, 1.0f / dist);
+                if (lp->shape == SHAPE_SPHERE)
+                    dist = sphere_entry(lp, xo, d, dist);
+                s = accel_transmittance(c->rs, xo, d, dist * 0.9999f, lp->background);
+                rays_cast++;
+            }
+            if (!keep && !f3_is_black(s))
+                e = v3_add(e, v3_scale(f3_to_v3(s), share * lambert_polygon(x, n, q, 3)));
+            seen_count += f3_max(s);
         }
         if (keep)
             seen[at++] = s;
-        else if (!f3_is_black(s))
-            e = v3_add(e, v3_scale(f3_to_v3(s), lambert_polygon(x, n, q, 3)));
-        seen_count += f3_max(s);
     }
     if (!keep)
         return e;
     if (seen_count == 0)
         return e;
-    int by_hidden = 2 * seen_count > pieces;
+    int by_hidden = 2 * seen_count > taken;
     if (by_hidden) {
         vec3 whole[POLY2_MAX];
         for (int i = 0; i < p->n; i++)
@@ -666,13 +692,15 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
     }
     at = 0;
     fan_start(&w, f, p, m);
-    while (fan_next(&w, q)) {
+    for (int g = 0; fan_next(&w, q); g++) {
         /* By the hidden ones, each takes away what it does not pass. */
         vec3 s = f3_to_v3(seen[at++]);
+        if ((g / per_fan) % share != offset)
+            continue;
         vec3 part = by_hidden ? v3_sub(v3_splat(1.0), s) : s;
         if (part.x > 0 || part.y > 0 || part.z > 0) {
-            double g = lambert_polygon(x, n, q, 3);
-            e = by_hidden ? v3_sub(e, v3_scale(part, g)) : v3_add(e, v3_scale(part, g));
+            double gl = share * lambert_polygon(x, n, q, 3);
+            e = by_hidden ? v3_sub(e, v3_scale(part, gl)) : v3_add(e, v3_scale(part, gl));
         }
     }
     return v3(e.x > 0 ? e.x : 0, e.y > 0 ? e.y : 0, e.z > 0 ? e.z : 0);
