@@ -51,9 +51,11 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
  * (x & 1) + 2 (y & 1) of its 2 x 2 level): the pieces are 4^j times as
  * large, and each point's ray goes to the centre of one of a piece's 4^j
  * sub-pieces, the one its digits name, so that the block's points see,
- * between them, the centres one point sees, for one point's rays (fewer
- * when the light has fewer pieces than the block has points: then points
- * 4^k apart share).  A split point always sees the light by rays, without
+ * between them, the centres one point sees, for one point's rays (when the
+ * light's polygon has about as many fan triangles as the fallback has
+ * pieces, the sun's disc say, the block's points also share those
+ * triangles: each takes every s-th; when it has fewer pieces than the
+ * block has points, points 4^k apart share).  A split point always sees the light by rays, without
  * searching for occluders, unless the scene has no more primitives than
  * are clipped exactly: Phase Two splits only where shadows are busy (a
  * mesh's detail, a busy shadow), and there the search nearly always finds
