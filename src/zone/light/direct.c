@@ -660,7 +660,7 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
     fan_start(&w, f, p, m);
     for (int g = 0; fan_next(&w, q); g++) {
         vec3f s = f3_splat(0.0f);
-        if ((g / per_fan) % share == offset) {
+        if (share == 1 || (g / per_fan) % share == offset) {
             taken++;
             vec3 ctr = split_centre(q, levels, index);
             vec3f to = f3_sub(v3_to_f3(ctr), xo);
@@ -695,7 +695,7 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
     for (int g = 0; fan_next(&w, q); g++) {
         /* By the hidden ones, each takes away what it does not pass. */
         vec3 s = f3_to_v3(seen[at++]);
-        if ((g / per_fan) % share != offset)
+        if (share > 1 && (g / per_fan) % share != offset)
             continue;
         vec3 part = by_hidden ? v3_sub(v3_splat(1.0), s) : s;
         if (part.x > 0 || part.y > 0 || part.z > 0) {

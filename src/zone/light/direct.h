@@ -55,8 +55,8 @@ double direct_irradiance(const direct_ctx *c, int light, vec3 x, vec3 n,
  * light's polygon has about as many fan triangles as the fallback has
  * pieces, the sun's disc say, the block's points also share those
  * triangles: each takes every s-th; when it has fewer pieces than the
- * block has points, points 4^k apart share).  A split point always sees the light by rays, without
- * searching for occluders, unless the scene has no more primitives than
+ * block has points, points 4^k apart share).  A split point always sees
+ * the light by rays, without searching for occluders, unless the scene has no more primitives than
  * are clipped exactly: Phase Two splits only where shadows are busy (a
  * mesh's detail, a busy shadow), and there the search nearly always finds
  * too many.  On the engine room skipping it takes Phase Two from 8.4 s to

@@ -84,11 +84,7 @@ static sky_part sky_share(int split, int count)
     while (levels-- > 0 && p.stride * 4 <= count)
         p.stride *= 4;
     p.first = index % p.stride;
-    p.width = block && p.stride >= 4 ? 4 : 1;
-    if (block && p.stride < 4) {
-        p.first = 0;
-        p.width = p.stride;
-    }
+    p.width = block && p.stride >= 4 ? 4 : 1; /* (a stride of 1 takes all) */
     return p;
 }
 
@@ -112,12 +108,12 @@ static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
     int total = 0;
     for (int i = 0; i < count; i++)
         total += picks[i].count;
-    sky_part share = sky_share(t->light_split, total);
+    sky_part mine = sky_share(t->light_split, total);
     vec3 e = v3(0, 0, 0);
     int k = 0;
     for (int i = 0; i < count; i++) {
         for (int j = 0; j < picks[i].count; j++, k++) {
-            if (!sky_takes(&share, k))
+            if (!sky_takes(&mine, k))
                 continue;
             vec3 d;
             double share = sky_portal_view_direction(&picks[i].view, j, picks[i].count, &d);
@@ -134,7 +130,7 @@ static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
             e = v3_add(e, v3_scale(f3_to_v3(f3_mul(l, tr)), share * c));
         }
     }
-    return v3_scale(e, (double)share.stride / share.width);
+    return v3_scale(e, (double)mine.stride / mine.width);
 }
 
 /* Whether the gather's ray along d reaches the sky, and with what: 0 when

@@ -82,7 +82,7 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
         member[3] = slot.block_first + slot.block_width + 1;
         memcpy(room, member, sizeof room);
     }
-    int top = room[members - 1] > room[0] ? room[members - 1] : room[0];
+    int top = room[members - 1]; /* the last member's room is the highest */
     if (memo && slot.samples > 0 && top < ZONE_MEMO_SAMPLES &&
         ((size_t)top + 1) * (size_t)k_max <= ZONE_MEMO_HITS) {
         if (memo->pixel != slot.pixel) {

@@ -325,24 +325,26 @@ static int grid_samples(const p2_ctx *c, int px, int py, int g, int split, uint3
  * read and one would miss: textured_box's images were 25% further from the
  * reference per pixel when its textured faces' blocks were shaded once). */
 #define FACET_COS 0.985f
-static int one_facet(const rscene *rs, const hit h[4], const vec3f x[4], const vec3f ng[4],
-                     float spacing)
+static int one_facet(const rscene *rs, const hit *h, const vec3f *x, const vec3f *ng,
+                     const int at[4], float spacing)
 {
     if (rs->alpha_count)
         return 0; /* a sample of partial coverage is two (push_sample) */
-    int surface = h[0].part >= rs->part_count ? zone_surface_of(rs, h[0].part) : -1;
+    int a = at[0];
+    int surface = h[a].part >= rs->part_count ? zone_surface_of(rs, h[a].part) : -1;
     if (surface < 0)
         return 0;
     rs_part first;
-    const rs_object *m = &rs->objects[rs_prim(rs, h[0].part, &first)->object];
+    const rs_object *m = &rs->objects[rs_prim(rs, h[a].part, &first)->object];
     if (m->texture || m->maps)
         return 0;
     for (int k = 0; k < 4; k++) {
+        int b = at[k];
         rs_part tmp;
-        if (h[k].part < rs->part_count || rs_prim(rs, h[k].part, &tmp)->is_light ||
-            (k > 0 && zone_surface_of(rs, h[k].part) != surface) ||
-            f3_dot(ng[k], ng[0]) < FACET_COS ||
-            fabsf(f3_dot(ng[0], f3_sub(x[k], x[0]))) > 0.5f * spacing)
+        if (h[b].part < rs->part_count || rs_prim(rs, h[b].part, &tmp)->is_light ||
+            (k > 0 && zone_surface_of(rs, h[b].part) != surface) ||
+            f3_dot(ng[b], ng[a]) < FACET_COS ||
+            fabsf(f3_dot(ng[a], f3_sub(x[b], x[a]))) > 0.5f * spacing)
             return 0;
     }
     return 1;
@@ -359,8 +361,8 @@ static int one_facet(const rscene *rs, const hit h[4], const vec3f x[4], const v
  * points.  The grid is there to find where the mesh's sheets change within
  * the pixel; a block on one facet holds no such change.  On the engine
  * room at 512 x 512 a detail pixel shades 19 points instead of 64, and
- * Phase Two takes about 0.8 of its time for 0.779% -> 0.795% per pixel and
- * the same error over 4 x 4 blocks (BENCHMARKS.md). */
+ * Phase Two takes 0.87 of its time for 0.779% -> 0.795% per pixel and the
+ * same error over 4 x 4 blocks (BENCHMARKS.md). */
 static int detail_samples(const p2_ctx *c, int px, int py, uint32_t first, seen_lights *lights,
                           p2_row *row, uint64_t *rays, int *edge, int *curved)
 {
@@ -386,20 +388,15 @@ static int detail_samples(const p2_ctx *c, int px, int py, uint32_t first, seen_
         for (int bx = 0; bx < G / 2; bx++) {
             int at[4] = {2 * by * G + 2 * bx, 2 * by * G + 2 * bx + 1, (2 * by + 1) * G + 2 * bx,
                          (2 * by + 1) * G + 2 * bx + 1};
-            hit bh[4] = {h[at[0]], h[at[1]], h[at[2]], h[at[3]]};
-            vec3f bx4[4] = {x[at[0]], x[at[1]], x[at[2]], x[at[3]]};
-            vec3f bn[4] = {ng[at[0]], ng[at[1]], ng[at[2]], ng[at[3]]};
             float spacing = c->pixel_angle * (h[at[0]].t + c->screen_dist) / G;
-            if (one_facet(rs, bh, bx4, bn, spacing)) {
+            if (one_facet(rs, h, x, ng, at, spacing)) {
                 int i = at[(bx + 2 * by) & 3];
-                vec3f o = org[i], d = dir[i];
-                hit hc = h[i];
                 int ls = DIRECT_SPLIT(DETAIL_SPLIT - 1, split_index(bx, by, DETAIL_SPLIT - 1)) |
                          DIRECT_SPLIT_BLOCK;
                 zone_gather_slot slot = gather_slot(c, px, py, i, N);
                 slot.block_first = (uint16_t)at[0];
                 slot.block_width = G;
-                if (!push_sample(rs, row, o, d, hc, 4 * w, ls, slot))
+                if (!push_sample(rs, row, org[i], dir[i], h[i], 4 * w, ls, slot))
                     return 0;
                 continue;
             }
