@@ -38,4 +38,16 @@ hit accel_intersect(const rscene *rs, vec3f o, vec3f d);
 int accel_occluded(const rscene *rs, vec3f o, vec3f d, float dist,
                    int target_is_background);
 
+/* accel_intersect for n rays from one origin o along unit directions
+ * d[i], into h[i]: the same hits as n calls, the rays traced as packets
+ * where the backend can. */
+void accel_intersect_n(const rscene *rs, vec3f o, const vec3f *d, int n, hit *h);
+
+/* accel_occluded for n rays from one origin o, to distances dist[i] along
+ * unit directions d[i]: hidden[i] is 1 or 0, the same answers as n calls
+ * of accel_occluded.  Rays from one point towards one light are nearly
+ * parallel, and the backend traces them as packets where it can. */
+void accel_occluded_n(const rscene *rs, vec3f o, const vec3f *d, const float *dist, int n,
+                      int target_is_background, unsigned char *hidden);
+
 #endif

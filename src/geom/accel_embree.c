@@ -35,6 +35,7 @@ typedef struct embree_accel {
     /* By layer and geometry id: the parts' kinds, then mesh k at
      * GEOM_KINDS + k (in the layer the mesh is in). */
     geom_map *map[2];
+    int packet; /* native packet width (4, 8, 16), 0: none */
 } embree_accel;
 
 static inline int prim_of(const geom_map *m, unsigned prim)
@@ -73,8 +74,7 @@ static void cull_filter(const struct RTCFilterFunctionNArguments *args)
     }
 }
 
-/* Spheres as user geometry: bounds, nearest and any hit of one ray (the
- * backend casts single rays: N is 1). */
+/* Spheres as user geometry: bounds, nearest and any hit. */
 static const rs_part *sphere_part(const void *user, unsigned prim)
 {
     const geom_map *m = user;
@@ -91,34 +91,49 @@ static void sphere_bounds(const struct RTCBoundsFunctionArguments *args)
     b->upper_x = p->p0.x + r; b->upper_y = p->p0.y + r; b->upper_z = p->p0.z + r;
 }
 
+/* Spheres' callbacks take a packet of N rays (N is 1 for single rays);
+ * RTCRayN's fields lie one after another, N floats each. */
+#define RAY_N(ray, n, field, i) (((float *)(ray))[(field) * (n) + (i)])
+enum { RN_OX, RN_OY, RN_OZ, RN_TNEAR, RN_DX, RN_DY, RN_DZ, RN_TIME, RN_TFAR };
+
 static void sphere_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
-    if (!args->valid[0])
-        return;
     const rs_part *p = sphere_part(args->geometryUserPtr, args->primID);
-    struct RTCRayHit *rh = (struct RTCRayHit *)args->rayhit;
-    vec3f o = f3(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z);
-    vec3f d = f3(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z);
-    float t = shape_sphere_hit(p, o, d, 0.0f, rh->ray.tfar);
-    if (t < 0.0f)
-        return;
-    rh->ray.tfar = t;
-    rh->hit.geomID = args->geomID;
-    rh->hit.primID = args->primID;
-    rh->hit.instID[0] = args->context->instID[0];
+    unsigned n = args->N;
+    float *ray = (float *)args->rayhit;
+    /* RTCRayHitN: the ray's 12 fields, then the hit's Ng (3), u, v,
+     * primID, geomID, instID. */
+    unsigned *hitv = (unsigned *)(ray + 12 * n);
+    for (unsigned i = 0; i < n; i++) {
+        if (args->valid[i] != -1)
+            continue;
+        vec3f o = f3(RAY_N(ray, n, RN_OX, i), RAY_N(ray, n, RN_OY, i), RAY_N(ray, n, RN_OZ, i));
+        vec3f d = f3(RAY_N(ray, n, RN_DX, i), RAY_N(ray, n, RN_DY, i), RAY_N(ray, n, RN_DZ, i));
+        float t = shape_sphere_hit(p, o, d, 0.0f, RAY_N(ray, n, RN_TFAR, i));
+        if (t < 0.0f)
+            continue;
+        RAY_N(ray, n, RN_TFAR, i) = t;
+        hitv[5 * n + i] = args->primID;
+        hitv[6 * n + i] = args->geomID;
+        hitv[7 * n + i] = args->context->instID[0];
+    }
 }
 
 static void sphere_occluded(const struct RTCOccludedFunctionNArguments *args)
 {
-    if (!args->valid[0])
-        return;
     const rs_part *p = sphere_part(args->geometryUserPtr, args->primID);
-    struct RTCRay *r = (struct RTCRay *)args->ray;
-    vec3f o = f3(r->org_x, r->org_y, r->org_z), d = f3(r->dir_x, r->dir_y, r->dir_z);
-    /* tfar is inclusive here (embree_any lowered it by one float). */
-    float tmax = nextafterf(r->tfar, INFINITY);
-    if (shape_sphere_hit(p, o, d, 0.0f, tmax) >= 0.0f)
-        r->tfar = -INFINITY;
+    unsigned n = args->N;
+    float *ray = (float *)args->ray;
+    for (unsigned i = 0; i < n; i++) {
+        if (args->valid[i] != -1)
+            continue;
+        vec3f o = f3(RAY_N(ray, n, RN_OX, i), RAY_N(ray, n, RN_OY, i), RAY_N(ray, n, RN_OZ, i));
+        vec3f d = f3(RAY_N(ray, n, RN_DX, i), RAY_N(ray, n, RN_DY, i), RAY_N(ray, n, RN_DZ, i));
+        /* tfar is inclusive here (the queries lowered it by one float). */
+        float tmax = nextafterf(RAY_N(ray, n, RN_TFAR, i), INFINITY);
+        if (shape_sphere_hit(p, o, d, 0.0f, tmax) >= 0.0f)
+            RAY_N(ray, n, RN_TFAR, i) = -INFINITY;
+    }
 }
 
 static void embree_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
@@ -146,6 +161,17 @@ static void embree_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
     }
 }
 
+/* Embree includes tfar; the contract excludes it: one float below. */
+static float below(float tmax)
+{
+    uint32_t bits;
+    memcpy(&bits, &tmax, sizeof bits);
+    if (tmax > 0.0f && bits < 0x7f800000u)
+        bits--;
+    memcpy(&tmax, &bits, sizeof bits);
+    return tmax;
+}
+
 static int embree_any(const accel *a, int layer, vec3f o, vec3f d, float tmax)
 {
     const embree_accel *e = (const embree_accel *)a;
@@ -157,18 +183,115 @@ static int embree_any(const accel *a, int layer, vec3f o, vec3f d, float tmax)
     r.org_x = o.x; r.org_y = o.y; r.org_z = o.z;
     r.dir_x = d.x; r.dir_y = d.y; r.dir_z = d.z;
     r.tnear = 0.0f;
-    /* Embree includes tfar; the contract excludes it: one float below. */
-    uint32_t bits;
-    memcpy(&bits, &tmax, sizeof bits);
-    if (tmax > 0.0f && bits < 0x7f800000u)
-        bits--;
-    memcpy(&r.tfar, &bits, sizeof bits);
+    r.tfar = below(tmax);
     r.time = 0.0f;
     r.mask = 0xffffffffu;
     r.id = 0;
     r.flags = 0;
     rtcOccluded1(e->scene[layer], &ctx, &r);
     return r.tfar < 0.0f;
+}
+
+/* Packets of the machine's native width (its `packet` lanes: 4, 8 or
+ * 16), laid out as RTCRay4/8/16 are; lanes already hidden are left out. */
+static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, const float *tmax,
+                         int n, unsigned char *hidden)
+{
+    const embree_accel *e = (const embree_accel *)a;
+    if (e->empty[layer])
+        return;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    int w = e->packet;
+    _Alignas(64) float ray[12 * 16];
+    unsigned *bits = (unsigned *)ray;
+    for (int base = 0; base < n; base += w) {
+        _Alignas(64) int valid[16];
+        int any = 0;
+        for (int j = 0; j < w; j++) {
+            int i = base + j;
+            valid[j] = i < n && !hidden[i] ? -1 : 0;
+            any |= valid[j];
+            vec3f di = i < n ? d[i] : f3(0.0f, 0.0f, 1.0f);
+            RAY_N(ray, w, RN_OX, j) = o.x;
+            RAY_N(ray, w, RN_OY, j) = o.y;
+            RAY_N(ray, w, RN_OZ, j) = o.z;
+            RAY_N(ray, w, RN_TNEAR, j) = 0.0f;
+            RAY_N(ray, w, RN_DX, j) = di.x;
+            RAY_N(ray, w, RN_DY, j) = di.y;
+            RAY_N(ray, w, RN_DZ, j) = di.z;
+            RAY_N(ray, w, RN_TIME, j) = 0.0f;
+            RAY_N(ray, w, RN_TFAR, j) = i < n ? below(tmax[i]) : 0.0f;
+            bits[9 * w + j] = 0xffffffffu; /* mask */
+            bits[10 * w + j] = (unsigned)j; /* id */
+            bits[11 * w + j] = 0;          /* flags */
+        }
+        if (!any)
+            continue;
+        if (w == 16)
+            rtcOccluded16(valid, e->scene[layer], &ctx, (struct RTCRay16 *)ray);
+        else if (w == 8)
+            rtcOccluded8(valid, e->scene[layer], &ctx, (struct RTCRay8 *)ray);
+        else
+            rtcOccluded4(valid, e->scene[layer], &ctx, (struct RTCRay4 *)ray);
+        for (int j = 0; j < w && base + j < n; j++)
+            if (valid[j] && RAY_N(ray, w, RN_TFAR, j) < 0.0f)
+                hidden[base + j] = 1;
+    }
+}
+
+/* Nearest hits in packets, as embree_any_n: RTCRayHitN is the ray's 12
+ * fields, then the hit's Ng (3), u, v, primID, geomID, instID. */
+static void embree_nearest_n(const accel *a, int layer, vec3f o, const vec3f *d, int n,
+                             const unsigned char *want, hit *h)
+{
+    const embree_accel *e = (const embree_accel *)a;
+    if (e->empty[layer])
+        return;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    int w = e->packet;
+    _Alignas(64) float rh[20 * 16];
+    unsigned *bits = (unsigned *)rh;
+    for (int base = 0; base < n; base += w) {
+        _Alignas(64) int valid[16];
+        int any = 0;
+        for (int j = 0; j < w; j++) {
+            int i = base + j;
+            valid[j] = i < n && want[i] ? -1 : 0;
+            any |= valid[j];
+            vec3f di = i < n ? d[i] : f3(0.0f, 0.0f, 1.0f);
+            RAY_N(rh, w, RN_OX, j) = o.x;
+            RAY_N(rh, w, RN_OY, j) = o.y;
+            RAY_N(rh, w, RN_OZ, j) = o.z;
+            RAY_N(rh, w, RN_TNEAR, j) = 0.0f;
+            RAY_N(rh, w, RN_DX, j) = di.x;
+            RAY_N(rh, w, RN_DY, j) = di.y;
+            RAY_N(rh, w, RN_DZ, j) = di.z;
+            RAY_N(rh, w, RN_TIME, j) = 0.0f;
+            RAY_N(rh, w, RN_TFAR, j) = i < n ? h[i].t : 0.0f;
+            bits[9 * w + j] = 0xffffffffu;
+            bits[10 * w + j] = (unsigned)j;
+            bits[11 * w + j] = 0;
+            bits[18 * w + j] = RTC_INVALID_GEOMETRY_ID; /* geomID */
+            bits[19 * w + j] = RTC_INVALID_GEOMETRY_ID; /* instID */
+        }
+        if (!any)
+            continue;
+        if (w == 16)
+            rtcIntersect16(valid, e->scene[layer], &ctx, (struct RTCRayHit16 *)rh);
+        else if (w == 8)
+            rtcIntersect8(valid, e->scene[layer], &ctx, (struct RTCRayHit8 *)rh);
+        else
+            rtcIntersect4(valid, e->scene[layer], &ctx, (struct RTCRayHit4 *)rh);
+        for (int j = 0; j < w && base + j < n; j++) {
+            unsigned geom = bits[18 * w + j];
+            if (!valid[j] || geom == RTC_INVALID_GEOMETRY_ID)
+                continue;
+            h[base + j].t = RAY_N(rh, w, RN_TFAR, j);
+            h[base + j].part = prim_of(&e->map[layer][geom], bits[17 * w + j]);
+        }
+    }
 }
 
 static void embree_destroy(accel *a)
@@ -326,6 +449,14 @@ zt_status accel_build_embree(rscene *rs, zt_error *err)
     if (rtcGetDeviceError(e->device) != RTC_ERROR_NONE) {
         embree_destroy(&e->base);
         return zt_fail(err, ZT_ERR_UNSUPPORTED, "Embree failed to build the scene");
+    }
+    e->packet = rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16
+                : rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) ? 8
+                : rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED) ? 4
+                                                                                             : 0;
+    if (e->packet) {
+        e->base.any_n = embree_any_n;
+        e->base.nearest_n = embree_nearest_n;
     }
     rs->accel = &e->base;
     return ZT_OK;

@@ -10,6 +10,16 @@ typedef struct accel {
     void (*nearest)(const struct accel *a, int layer, vec3f o, vec3f d, hit *h);
     /* Whether any primitive is hit in (0, tmax). */
     int (*any)(const struct accel *a, int layer, vec3f o, vec3f d, float tmax);
+    /* The same for n rays from one origin, where the backend has packets
+     * (NULL: it has not): sets hidden[i] for each ray i not yet hidden
+     * that hits something in (0, tmax[i]). */
+    void (*any_n)(const struct accel *a, int layer, vec3f o, const vec3f *d, const float *tmax,
+                  int n, unsigned char *hidden);
+    /* Nearest hits of n rays from one origin, where the backend has
+     * packets (NULL: it has not): lowers h[i].t and sets h[i].part as
+     * nearest does, for the rays whose want[i] is set. */
+    void (*nearest_n)(const struct accel *a, int layer, vec3f o, const vec3f *d, int n,
+                      const unsigned char *want, hit *h);
     void (*destroy)(struct accel *a);
     /* Whether the layer has any primitives (set by accel_build): most
      * scenes have only planes in one of them, and the call is skipped. */

@@ -175,6 +175,98 @@ int accel_occluded(const rscene *rs, vec3f o, vec3f d, float dist,
     return 0;
 }
 
+/* Rays accel_occluded_n takes at a time. */
+#define ACCEL_N_MAX 64
+
+/* One layer's primitives for the rays not yet hidden. */
+static void prims_any_n(const accel *a, int layer, vec3f o, const vec3f *d, const float *tmax,
+                        int n, unsigned char *hidden)
+{
+    if (!a->has_prims[layer])
+        return;
+    if (a->any_n && !a->bvh) {
+        a->any_n(a, layer, o, d, tmax, n, hidden);
+        return;
+    }
+    for (int i = 0; i < n; i++)
+        if (!hidden[i]) {
+            ray4 r = ray4_make(o, d[i]);
+            bvh_ray b;
+            bvh_ray_init(&b, &r, o, d[i]);
+            hidden[i] = (unsigned char)prims_any(a, layer, &b, tmax[i]);
+        }
+}
+
+void accel_occluded_n(const rscene *rs, vec3f o, const vec3f *d, const float *dist, int n,
+                      int target_is_background, unsigned char *hidden)
+{
+    if (__builtin_expect(rs->alpha_count != 0, 0) || n <= 1) {
+        for (int i = 0; i < n; i++)
+            hidden[i] = (unsigned char)accel_occluded(rs, o, d[i], dist[i], target_is_background);
+        return;
+    }
+    const accel *a = rs->accel;
+    /* The rule of accel_occluded, lane by lane: the foreground up to the
+     * target (or everywhere, for a background target), then the
+     * background before it. */
+    float reach[ACCEL_N_MAX];
+    for (int base = 0; base < n; base += ACCEL_N_MAX) {
+        int m = n - base < ACCEL_N_MAX ? n - base : ACCEL_N_MAX;
+        const vec3f *dd = d + base;
+        unsigned char *hh = hidden + base;
+        for (int i = 0; i < m; i++) {
+            reach[i] = target_is_background ? FLT_MAX : dist[base + i];
+            ray4 r = ray4_make(o, dd[i]);
+            hh[i] = (unsigned char)planes_any(rs, 0, &r, reach[i]);
+        }
+        prims_any_n(a, 0, o, dd, reach, m, hh);
+        if (!target_is_background)
+            continue;
+        for (int i = 0; i < m; i++)
+            if (!hh[i]) {
+                ray4 r = ray4_make(o, dd[i]);
+                hh[i] = (unsigned char)planes_any(rs, 1, &r, dist[base + i]);
+            }
+        prims_any_n(a, 1, o, dd, dist + base, m, hh);
+    }
+}
+
+void accel_intersect_n(const rscene *rs, vec3f o, const vec3f *d, int n, hit *h)
+{
+    const accel *a = rs->accel;
+    if (__builtin_expect(rs->alpha_count != 0, 0) || n <= 1 || !a->nearest_n || a->bvh) {
+        for (int i = 0; i < n; i++)
+            h[i] = accel_intersect(rs, o, d[i]);
+        return;
+    }
+    /* accel_intersect's order lane by lane: a layer's primitives, then its
+     * planes; the background only for rays the foreground missed. */
+    unsigned char want[ACCEL_N_MAX];
+    for (int base = 0; base < n; base += ACCEL_N_MAX) {
+        int m = n - base < ACCEL_N_MAX ? n - base : ACCEL_N_MAX;
+        hit *hh = h + base;
+        for (int i = 0; i < m; i++) {
+            hh[i] = (hit){FLT_MAX, -1};
+            want[i] = 1;
+        }
+        for (int layer = 0; layer < 2; layer++) {
+            if (a->has_prims[layer])
+                a->nearest_n(a, layer, o, d + base, m, want, hh);
+            for (int i = 0; i < m; i++) {
+                if (!want[i])
+                    continue;
+                ray4 r = ray4_make(o, d[base + i]);
+                planes_nearest(rs, layer, &r, &hh[i].t, &hh[i].part);
+                if (hh[i].part >= 0)
+                    want[i] = 0;
+            }
+        }
+        for (int i = 0; i < m; i++)
+            if (hh[i].part < 0)
+                hh[i] = (hit){FLT_MAX, -1};
+    }
+}
+
 void accel_free(struct accel *a)
 {
     if (a)

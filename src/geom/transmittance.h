@@ -23,6 +23,13 @@ vec3f accel_transmittance(const rscene *rs, vec3f o, vec3f d, float dist,
 vec3f accel_transmittance_panes(const rscene *rs, vec3f o, vec3f d, float dist,
                                 int target_is_background, int *first_pane);
 
+/* accel_transmittance_panes for n rays from one origin o (unit directions
+ * d[i], distances dist[i]) into tr[i] and, when first_pane is not NULL,
+ * first_pane[i]: the same answers, the rays' first hits found together
+ * (packets, accel_intersect_n). */
+void accel_transmittance_panes_n(const rscene *rs, vec3f o, const vec3f *d, const float *dist,
+                                 int n, int target_is_background, vec3f *tr, int *first_pane);
+
 /* The same as one number (the channels' mean), for the zone tracer's
  * scalar visibility. */
 static inline float accel_transmittance_mean(const rscene *rs, vec3f o, vec3f d, float dist,

@@ -657,6 +657,12 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
     vec3 e = v3(0, 0, 0);
     fan_walk w;
     vec3 q[3];
+    /* Without panes a ray's answer is 0 or 1, and the point's rays go
+     * together as packets (nearly parallel: they all aim at the light). */
+    int packed = keep && !c->rs->pane_count;
+    vec3f dir[BY_RAYS_KEPT];
+    float reach[BY_RAYS_KEPT];
+    int ray_of[BY_RAYS_KEPT], rays = 0;
     fan_start(&w, f, p, m);
     for (int g = 0; fan_next(&w, q); g++) {
         vec3f s = f3_splat(0.0f);
@@ -669,8 +675,13 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
                 vec3f d = f3_scale(to, 1.0f / dist);
                 if (lp->shape == SHAPE_SPHERE)
                     dist = sphere_entry(lp, xo, d, dist);
-                s = accel_transmittance(c->rs, xo, d, dist * 0.9999f, lp->background);
                 rays_cast++;
+                if (packed) {
+                    dir[rays] = d;
+                    reach[rays] = dist * 0.9999f;
+                    ray_of[rays++] = at;
+                } else
+                    s = accel_transmittance(c->rs, xo, d, dist * 0.9999f, lp->background);
             }
             if (!keep && !f3_is_black(s))
                 e = v3_add(e, v3_scale(f3_to_v3(s), share * lambert_polygon(x, n, q, 3)));
@@ -678,6 +689,15 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
         }
         if (keep)
             seen[at++] = s;
+    }
+    if (rays) {
+        unsigned char hidden[BY_RAYS_KEPT];
+        accel_occluded_n(c->rs, xo, dir, reach, rays, lp->background, hidden);
+        for (int i = 0; i < rays; i++)
+            if (!hidden[i]) {
+                seen[ray_of[i]] = f3_splat(1.0f);
+                seen_count += 1.0;
+            }
     }
     if (!keep)
         return e;

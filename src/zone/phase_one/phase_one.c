@@ -94,22 +94,59 @@ static int sky_takes(const sky_part *p, int k)
     return r >= 0 && r < p->width;
 }
 
+/* Sky rays a point sends to the scene at a time. */
+#define SKY_PACKET 64
+
 /* The share of the gather's count that a point aims at portals. */
 #define SKY_PORTAL_SHARE 2
 
 /* The sky's light through the portals that a point aims at (sky_portals.h):
  * over each, the directions whose first pane is one of its own.  A split
  * point takes its share of them, as of the gather's. */
-static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
-                                const sky_portal_pick *picks, int count)
+/* Portal directions waiting for their rays (sky_through_portals). */
+typedef struct portal_rays {
+    vec3f o;
+    int n;
+    vec3f d[SKY_PACKET];
+    double weight[SKY_PACKET]; /* share x cosine */
+    int portal[SKY_PACKET];
+} portal_rays;
+
+/* Casts the waiting rays together and adds to *e the light of those
+ * whose first pane is their own portal's. */
+static void portal_rays_flush(zone_trace *t, portal_rays *pr, vec3 *e)
 {
     const zone_forest *f = t->f;
     const rscene *rs = &t->r->rs;
+    float far[SKY_PACKET];
+    int pane[SKY_PACKET];
+    vec3f tr[SKY_PACKET];
+    if (!pr->n)
+        return;
+    for (int i = 0; i < pr->n; i++)
+        far[i] = FLT_MAX;
+    t->rays += (uint64_t)pr->n;
+    accel_transmittance_panes_n(rs, pr->o, pr->d, far, pr->n, 1, tr, pane);
+    for (int i = 0; i < pr->n; i++) {
+        if (f3_is_black(tr[i]) || pane[i] < 0 || f->portals.of_prim[pane[i]] != pr->portal[i])
+            continue;
+        vec3f l = f->sky_dir_count ? distant_map_radiance(&rs->distant, pr->d[i]) : rs->sky;
+        *e = v3_add(*e, v3_scale(f3_to_v3(f3_mul(l, tr[i])), pr->weight[i]));
+    }
+    pr->n = 0;
+}
+
+static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
+                                const sky_portal_pick *picks, int count)
+{
     int total = 0;
     for (int i = 0; i < count; i++)
         total += picks[i].count;
     sky_part mine = sky_share(t->light_split, total);
     vec3 e = v3(0, 0, 0);
+    portal_rays pr;
+    pr.o = o;
+    pr.n = 0;
     int k = 0;
     for (int i = 0; i < count; i++) {
         for (int j = 0; j < picks[i].count; j++, k++) {
@@ -120,34 +157,35 @@ static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
             double c = v3_dot(n, d);
             if (!(share > 0) || c <= 0)
                 continue;
-            int pane;
-            t->rays++;
-            vec3f df = v3_to_f3(d);
-            vec3f tr = accel_transmittance_panes(rs, o, df, FLT_MAX, 1, &pane);
-            if (f3_is_black(tr) || pane < 0 || f->portals.of_prim[pane] != picks[i].portal)
-                continue;
-            vec3f l = f->sky_dir_count ? distant_map_radiance(&rs->distant, df) : rs->sky;
-            e = v3_add(e, v3_scale(f3_to_v3(f3_mul(l, tr)), share * c));
+            pr.d[pr.n] = v3_to_f3(d);
+            pr.weight[pr.n] = share * c;
+            pr.portal[pr.n++] = picks[i].portal;
+            if (pr.n == SKY_PACKET)
+                portal_rays_flush(t, &pr, &e);
         }
     }
+    portal_rays_flush(t, &pr, &e);
     return v3_scale(e, (double)mine.stride / mine.width);
 }
 
-/* Whether the gather's ray along d reaches the sky, and with what: 0 when
- * the portals' estimate takes d (sky_portals_claim: that light is
- * theirs). */
-static vec3f sky_gather_ray(zone_trace *t, vec3f o, vec3f d, const sky_portal_pick *picks,
-                            int count)
+/* Whether the gather's rays along d[0..n) (n <= SKY_PACKET) reach the
+ * sky, and with what, into tr: 0 where the portals' estimate takes the
+ * direction (sky_portals_claim: that light is theirs).  The rays leave o
+ * together (packets). */
+static void sky_gather_rays(zone_trace *t, vec3f o, const vec3f *d, int n,
+                            const sky_portal_pick *picks, int count, vec3f *tr)
 {
-    const rscene *rs = &t->r->rs;
-    t->rays++;
-    if (!count)
-        return accel_transmittance(rs, o, d, FLT_MAX, 1);
-    int pane;
-    vec3f tr = accel_transmittance_panes(rs, o, d, FLT_MAX, 1, &pane);
-    if (pane >= 0 && sky_portals_claim(picks, count, t->f->portals.of_prim[pane], f3_to_v3(d)))
-        return f3_splat(0.0f);
-    return tr;
+    float far[SKY_PACKET];
+    int pane[SKY_PACKET];
+    for (int i = 0; i < n; i++)
+        far[i] = FLT_MAX;
+    t->rays += (uint64_t)n;
+    accel_transmittance_panes_n(&t->r->rs, o, d, far, n, 1, tr, count ? pane : NULL);
+    if (count)
+        for (int i = 0; i < n; i++)
+            if (pane[i] >= 0 &&
+                sky_portals_claim(picks, count, t->f->portals.of_prim[pane[i]], f3_to_v3(d[i])))
+                tr[i] = f3_splat(0.0f);
 }
 
 vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
@@ -168,16 +206,26 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
          * ray). */
         vec3f seen = f3_splat(0.0f), all = f3_splat(0.0f);
         sky_part share = sky_share(t->light_split, f->sky_dir_count);
-        for (int k = 0; k < f->sky_dir_count; k++) {
-            float c = f3_dot(nf, f->sky_dirs[k]);
-            if (c <= 0.0f)
-                continue;
-            all = f3_madd(all, f->sky_weight[k], c);
-            if (!sky_takes(&share, k))
-                continue;
-            vec3f tr = sky_gather_ray(t, o, f->sky_dirs[k], picks, picked);
-            if (!f3_is_black(tr))
-                seen = f3_madd(seen, f3_mul(f->sky_weight[k], tr), c);
+        vec3f dir[SKY_PACKET], tr[SKY_PACKET];
+        float cosine[SKY_PACKET];
+        int kept[SKY_PACKET];
+        for (int k = 0; k < f->sky_dir_count;) {
+            int rays = 0;
+            for (; k < f->sky_dir_count && rays < SKY_PACKET; k++) {
+                float c = f3_dot(nf, f->sky_dirs[k]);
+                if (c <= 0.0f)
+                    continue;
+                all = f3_madd(all, f->sky_weight[k], c);
+                if (!sky_takes(&share, k))
+                    continue;
+                dir[rays] = f->sky_dirs[k];
+                cosine[rays] = c;
+                kept[rays++] = k;
+            }
+            sky_gather_rays(t, o, dir, rays, picks, picked, tr);
+            for (int i = 0; i < rays; i++)
+                if (!f3_is_black(tr[i]))
+                    seen = f3_madd(seen, f3_mul(f->sky_weight[kept[i]], tr[i]), cosine[i]);
         }
         /* A split point's share of the directions stands for all of them:
          * the block's points together see what one point's would. */
@@ -192,13 +240,20 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
     vec3f open = f3_splat(0.0f);
     sky_part share = sky_share(t->light_split, f->q.gather);
     int taken = 0;
-    for (int k = share.first; k < f->q.gather; k++) {
-        if (!sky_takes(&share, k))
-            continue;
-        const vec3 *dk = &f->dirs[k];
-        vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
-        open = f3_add(open, sky_gather_ray(t, o, v3_to_f3(d), picks, picked));
-        taken++;
+    vec3f dir[SKY_PACKET], tr[SKY_PACKET];
+    for (int k = share.first; k < f->q.gather;) {
+        int rays = 0;
+        for (; k < f->q.gather && rays < SKY_PACKET; k++) {
+            if (!sky_takes(&share, k))
+                continue;
+            const vec3 *dk = &f->dirs[k];
+            vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
+            dir[rays++] = v3_to_f3(d);
+        }
+        sky_gather_rays(t, o, dir, rays, picks, picked, tr);
+        for (int i = 0; i < rays; i++)
+            open = f3_add(open, tr[i]);
+        taken += rays;
     }
     /* Each channel as sky x (pi x count / n): open holds whole counts
      * unless a pane is in the way. */

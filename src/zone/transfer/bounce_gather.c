@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "geom/accel.h"
 #include "geom/ray_offset.h"
 #include "util/sampler.h"
 #include "util/vec3_convert.h"
@@ -12,6 +13,8 @@
 /* The fewest directions whose spread says whether the rest are worth
  * casting. */
 #define FIRST_MIN 16
+/* Directions traced together. */
+#define BATCH 64
 
 /* Sobol's second dimension: the direction numbers of x + 1, each the one
  * before xor itself shifted by one. */
@@ -64,12 +67,28 @@ int bounce_gather(zone_trace *t, const vec3 *dirs, int n_dirs, vec3 x, vec3 n, i
     vec3 sum = v3(0, 0, 0);
     double s1 = 0, s2 = 0;
     int first = n_dirs / 4 >= FIRST_MIN ? n_dirs / 4 : n_dirs;
+    /* The rays go to the scene a batch at a time (packets from one
+     * point), their hits then read one by one. */
+    vec3f dir[BATCH];
+    hit hits[BATCH];
+    int batch_start = 0, batch_end = 0;
     for (int k = 0; k < n_dirs; k++) {
         if (k == first && !good_enough(s1, s2, k, n_dirs, lim))
             return 0;
-        vec3 d = v3_add(v3_add(v3_scale(tt, dirs[k].x), v3_scale(bb, dirs[k].y)),
-                        v3_scale(n, dirs[k].z));
-        vec3 l = zone_radiance(t, o, v3_to_f3(v3_normalize(d)), level, level,
+        if (k == batch_end) {
+            int end = k < first ? first : n_dirs;
+            batch_start = k;
+            batch_end = end - k < BATCH ? end : k + BATCH;
+            for (int j = k; j < batch_end; j++) {
+                vec3 d = v3_add(v3_add(v3_scale(tt, dirs[j].x), v3_scale(bb, dirs[j].y)),
+                                v3_scale(n, dirs[j].z));
+                dir[j - k] = v3_to_f3(v3_normalize(d));
+            }
+            accel_intersect_n(&t->r->rs, o, dir, batch_end - k, hits);
+            t->rays += (uint64_t)(batch_end - k);
+        }
+        t->first_hit = &hits[k - batch_start];
+        vec3 l = zone_radiance(t, o, dir[k - batch_start], level, level,
                                ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0);
         double y = lum(l);
         s1 += y;

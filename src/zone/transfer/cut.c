@@ -92,68 +92,122 @@ static int faces(const gather *g, const float c[3], const float n[3])
     return n[0] * (g->xf.x - c[0]) + n[1] * (g->xf.y - c[1]) + n[2] * (g->xf.z - c[2]) > 0;
 }
 
-/* The share of a cluster's power a ray reaches: rays to its two children's
- * representatives (or its elements' centres), weighted by their power, so
- * that a cluster half hidden counts about half; one ray to its own
- * representative counted it whole or not at all, and blotched the maps
- * beside the Cornell box's blocks (level 2 at 128 x 128: 2.77% against
- * 2.35% at the same cut). */
-static double seen_share(gather *g, const sender_node *node)
+/* The points whose rays say what share of a cluster's power reaches the
+ * receiver: its two children's representatives (or its elements'
+ * centres), weighted by their power, so that a cluster half hidden counts
+ * about half; one ray to its own representative counted it whole or not
+ * at all, and blotched the maps beside the Cornell box's blocks (level 2
+ * at 128 x 128: 2.77% against 2.35% at the same cut).  Returns how many
+ * (each of positive power) and their weights' whole in *wsum. */
+typedef struct see_target {
+    vec3 to;
+    double w;
+    int background;
+} see_target;
+
+/* Targets seen_targets gives at most: an inner node's descendants, or a
+ * leaf's elements (a leaf of more, which only coincident elements make,
+ * is taken in runs of this many). */
+#define SEE_TARGETS_MAX 8
+
+/* Whether any of leaf elements [first, first + count) faces the receiver:
+ * then only those that face it vote (all, when none does). */
+static int leaf_any_facing(const gather *g, int first, int count)
+{
+    int any = 0;
+    for (int i = first; i < first + count; i++)
+        any |= faces(g, g->t->elems[i].c, g->t->elems[i].n);
+    return any;
+}
+
+/* The targets of leaf elements [first, first + count), adding their
+ * weights to *wsum. */
+static int leaf_targets(const gather *g, int first, int count, int any, see_target *out,
+                        double *wsum)
 {
     const sender_tree *t = g->t;
-    double seen = 0, wsum = 0;
+    int m = 0;
+    for (int i = first; i < first + count; i++) {
+        double w = sender_elem_power(t, i);
+        const float *c = t->elems[i].c;
+        if (any && !faces(g, c, t->elems[i].n))
+            continue;
+        *wsum += w;
+        if (w > 0)
+            out[m++] = (see_target){v3(c[0], c[1], c[2]), w, t->elems[i].background};
+    }
+    return m;
+}
+
+/* The targets of a cluster (of an inner node or a leaf of at most
+ * SEE_TARGETS_MAX elements) into out, their weights' whole in *wsum;
+ * returns how many. */
+static int seen_targets(const gather *g, const sender_node *node, see_target *out, double *wsum)
+{
+    const sender_tree *t = g->t;
+    *wsum = 0;
     if (node->count > 0) {
-        int first = -1 - node->left, any = 0;
-        for (int i = first; i < first + node->count; i++)
-            any |= faces(g, t->elems[i].c, t->elems[i].n);
-        for (int i = first; i < first + node->count; i++) {
-            double w = sender_elem_power(t, i);
-            const float *c = t->elems[i].c;
-            if (any && !faces(g, t->elems[i].c, t->elems[i].n))
-                continue;
-            wsum += w;
-            if (w > 0)
-                seen += w * cut_visible(g->rs, g->xo, v3(c[0], c[1], c[2]), t->elems[i].background,
-                                        g->st);
-        }
-    } else {
-        /* Descendants a few levels down where there are any. */
-        int32_t kids[2 << SEEN_DEPTH];
-        int nk = 0;
-        kids[nk++] = node->left;
-        kids[nk++] = node->left + 1;
-        for (int level = 0; level < SEEN_DEPTH; level++) {
-            int32_t next[2 << SEEN_DEPTH];
-            int nn = 0;
-            for (int k = 0; k < nk; k++) {
-                const sender_node *c = &t->nodes[kids[k]];
-                if (c->count == 0 && nn + 2 <= (2 << SEEN_DEPTH)) {
-                    next[nn++] = c->left;
-                    next[nn++] = c->left + 1;
-                } else if (nn < (2 << SEEN_DEPTH)) {
-                    next[nn++] = kids[k];
-                }
+        int first = -1 - node->left;
+        return leaf_targets(g, first, node->count, leaf_any_facing(g, first, node->count), out,
+                            wsum);
+    }
+    /* Descendants a few levels down where there are any. */
+    int32_t kids[2 << SEEN_DEPTH];
+    int nk = 0;
+    kids[nk++] = node->left;
+    kids[nk++] = node->left + 1;
+    for (int level = 0; level < SEEN_DEPTH; level++) {
+        int32_t next[2 << SEEN_DEPTH];
+        int nn = 0;
+        for (int k = 0; k < nk; k++) {
+            const sender_node *c = &t->nodes[kids[k]];
+            if (c->count == 0 && nn + 2 <= (2 << SEEN_DEPTH)) {
+                next[nn++] = c->left;
+                next[nn++] = c->left + 1;
+            } else if (nn < (2 << SEEN_DEPTH)) {
+                next[nn++] = kids[k];
             }
-            memcpy(kids, next, (size_t)nn * sizeof *kids);
-            nk = nn;
         }
-        /* A representative facing away from the receiver is hidden by
-         * its own surface, whatever the rest of its cluster does: only
-         * those facing it vote (all, when none does). */
-        int facing[2 << SEEN_DEPTH], any = 0;
-        for (int k = 0; k < nk; k++) {
-            const sender_light *cl = &t->light[kids[k]];
-            facing[k] = faces(g, cl->rep, cl->rep_n);
-            any |= facing[k] && cl->power > 0;
-        }
-        for (int k = 0; k < nk; k++) {
-            const sender_light *cl = &t->light[kids[k]];
-            if (any && !facing[k])
-                continue;
-            wsum += cl->power;
-            if (cl->power > 0)
-                seen += cl->power * cut_visible(g->rs, g->xo, v3(cl->rep[0], cl->rep[1], cl->rep[2]),
-                                                t->nodes[kids[k]].background, g->st);
+        memcpy(kids, next, (size_t)nn * sizeof *kids);
+        nk = nn;
+    }
+    /* A representative facing away from the receiver is hidden by its own
+     * surface, whatever the rest of its cluster does: only those facing it
+     * vote (all, when none does). */
+    int facing[2 << SEEN_DEPTH], any = 0, m = 0;
+    for (int k = 0; k < nk; k++) {
+        const sender_light *cl = &t->light[kids[k]];
+        facing[k] = faces(g, cl->rep, cl->rep_n);
+        any |= facing[k] && cl->power > 0;
+    }
+    for (int k = 0; k < nk; k++) {
+        const sender_light *cl = &t->light[kids[k]];
+        if (any && !facing[k])
+            continue;
+        *wsum += cl->power;
+        if (cl->power > 0)
+            out[m++] = (see_target){v3(cl->rep[0], cl->rep[1], cl->rep[2]), cl->power,
+                                    t->nodes[kids[k]].background};
+    }
+    return m;
+}
+
+static double seen_share(gather *g, const sender_node *node)
+{
+    see_target tg[SEE_TARGETS_MAX];
+    double wsum = 0, seen = 0;
+    if (node->count <= SEE_TARGETS_MAX) {
+        int m = seen_targets(g, node, tg, &wsum);
+        for (int i = 0; i < m; i++)
+            seen += tg[i].w * cut_visible(g->rs, g->xo, tg[i].to, tg[i].background, g->st);
+    } else {
+        int first = -1 - node->left, any = leaf_any_facing(g, first, node->count);
+        for (int at = first; at < first + node->count; at += SEE_TARGETS_MAX) {
+            int run = first + node->count - at;
+            int m = leaf_targets(g, at, run < SEE_TARGETS_MAX ? run : SEE_TARGETS_MAX, any, tg,
+                                 &wsum);
+            for (int i = 0; i < m; i++)
+                seen += tg[i].w * cut_visible(g->rs, g->xo, tg[i].to, tg[i].background, g->st);
         }
     }
     return wsum > 0 ? seen / wsum : 0;
@@ -268,6 +322,112 @@ static void see(gather *g, cand *c, double total[3])
     }
 }
 
+
+/* Rays see_all casts together. */
+#define SEE_BATCH 64
+
+/* A batch of candidates' rays: each candidate's targets, in order. */
+typedef struct see_batch {
+    int rays, owners;
+    vec3f dir[SEE_BATCH];
+    float dist[SEE_BATCH];
+    unsigned char bg[SEE_BATCH], cast[SEE_BATCH], hidden[SEE_BATCH];
+    double w[SEE_BATCH];
+    int owner_first[SEE_BATCH + 1];
+    cand *owner[SEE_BATCH];
+    double owner_wsum[SEE_BATCH];
+} see_batch;
+
+/* Casts the batch's rays (packets from the receiver, by layer of their
+ * targets) and gives each candidate its share seen, in order, as see()
+ * would. */
+static void see_flush(gather *g, see_batch *b, double total[3])
+{
+    if (!b->owners)
+        return;
+    for (int layer = 0; layer < 2; layer++) {
+        vec3f dir[SEE_BATCH];
+        float dist[SEE_BATCH];
+        unsigned char hidden[SEE_BATCH];
+        int idx[SEE_BATCH], m = 0;
+        for (int i = 0; i < b->rays; i++)
+            if (b->bg[i] == layer && b->cast[i]) {
+                idx[m] = i;
+                dir[m] = b->dir[i];
+                dist[m++] = b->dist[i];
+            }
+        if (!m)
+            continue;
+        accel_occluded_n(g->rs, g->xo, dir, dist, m, layer, hidden);
+        for (int k = 0; k < m; k++)
+            b->hidden[idx[k]] = hidden[k];
+    }
+    b->owner_first[b->owners] = b->rays;
+    for (int o = 0; o < b->owners; o++) {
+        double seen = 0;
+        for (int i = b->owner_first[o]; i < b->owner_first[o + 1]; i++)
+            seen += b->w[i] * (b->cast[i] && !b->hidden[i] ? 1.0 : 0.0);
+        double sh = b->owner_wsum[o] > 0 ? seen / b->owner_wsum[o] : 0;
+        cand *c = b->owner[o];
+        c->seen = (float)sh;
+        for (int ch = 0; ch < 3; ch++) {
+            float e = (float)(c->est[ch] * sh);
+            total[ch] += (double)e - c->est[ch];
+            c->est[ch] = e;
+        }
+    }
+    b->rays = b->owners = 0;
+}
+
+/* see() for every candidate of c[0..count), their rays cast together.
+ * Through panes a ray's answer is a fraction, and they go one by one. */
+static void see_all(gather *g, cand *c, int count, double total[3])
+{
+    if (g->rs->pane_count) {
+        for (int h = 0; h < count; h++)
+            see(g, &c[h], total);
+        return;
+    }
+    see_batch b;
+    b.rays = b.owners = 0;
+    for (int h = 0; h < count; h++) {
+        if (c[h].seen != -1 || !(lumf(c[h].est) > 0)) {
+            if (c[h].seen == -1)
+                c[h].seen = -2;
+            continue;
+        }
+        const sender_node *node = &g->t->nodes[cand_node(&c[h])];
+        if (node->count > SEE_TARGETS_MAX) {
+            /* (Its rays one by one, after the batch's: the same order.) */
+            see_flush(g, &b, total);
+            see(g, &c[h], total);
+            continue;
+        }
+        see_target tg[SEE_TARGETS_MAX];
+        double wsum;
+        int m = seen_targets(g, node, tg, &wsum);
+        if (b.rays + m > SEE_BATCH)
+            see_flush(g, &b, total);
+        c[h].seen = -2;
+        b.owner[b.owners] = &c[h];
+        b.owner_wsum[b.owners] = wsum;
+        b.owner_first[b.owners++] = b.rays;
+        for (int i = 0; i < m; i++) {
+            vec3f d = f3_sub(v3_to_f3(tg[i].to), g->xo);
+            float dist = f3_length(d);
+            b.w[b.rays] = tg[i].w;
+            b.bg[b.rays] = (unsigned char)tg[i].background;
+            b.cast[b.rays] = dist > 0.0f;
+            if (dist > 0.0f) {
+                g->st->rays++;
+                b.dir[b.rays] = f3_scale(d, 1.0f / dist);
+                b.dist[b.rays] = dist * 0.9999f;
+            }
+            b.rays++;
+        }
+    }
+    see_flush(g, &b, total);
+}
 
 /* A max-heap on err, ties to the lower node index (a fixed order). */
 static int above(const cand *a, const cand *b)
@@ -411,10 +571,9 @@ static vec3 refine(gather *g, cut_state *s, vec3 x, vec3 n, const cut_params *c,
             heap_push(heap, &s->hn, ch);
         }
     }
-    for (int h = 0; h < s->hn; h++) {
-        see(g, &heap[h], total);
+    see_all(g, heap, s->hn, total);
+    for (int h = 0; h < s->hn; h++)
         record(rec, cand_node(&heap[h]), heap[h].seen);
-    }
     return v3(dmax(0.0, total[0] + s->exact[0]), dmax(0.0, total[1] + s->exact[1]),
               dmax(0.0, total[2] + s->exact[2]));
 }
