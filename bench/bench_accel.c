@@ -2,7 +2,11 @@
  * for nearest-hit and visibility queries, on one thread and on all, for the
  * project's scenes and two synthetic scenes of about 100k triangles.  The
  * rays are a path tracer's: camera rays, diffuse bounces from their hits,
- * and visibility rays between hit points. */
+ * and visibility rays between hit points.  Then, on the scenes Embree
+ * takes (above 1,000 primitives), the zone tracer's rays from one point,
+ * one at a time against together (accel_intersect_n, accel_occluded_n):
+ * 64 directions over a hit point's hemisphere, and 64 rays from a hit
+ * point to a small patch (a light's pieces). */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
 #include <math.h>
@@ -15,6 +19,7 @@
 #include "geom/accel.h"
 #include "geom/ray_offset.h"
 #include "geom/shapes.h"
+#include "render/prim.h"
 #include "render/render_scene.h"
 #include "scene/scene.h"
 #include "bench_rays.h"
@@ -66,6 +71,126 @@ static void bench_scene(const char *name, const zt_scene *scene)
                throughput(&rs, &set, 1, 1), throughput(&rs, &set, 1, all));
         fflush(stdout);
     }
+    bench_free_rays(&set);
+    rscene_free(&rs);
+}
+
+/* ---- rays from one point ---- */
+
+enum { BUNDLE = 64, POINTS = 2048 };
+
+typedef struct point_rays {
+    vec3f o[POINTS], d[POINTS][BUNDLE];
+    float dist[POINTS][BUNDLE];
+} point_rays;
+
+/* From the hit points of the set's first nearest rays: a hemisphere of
+ * directions about the normal (hemi), or rays to points of a patch a
+ * tenth of the scene's size away (not hemi). */
+static int make_point_rays(const rscene *rs, const ray_set *set, int hemi, point_rays *pr)
+{
+    uint32_t seed = 99;
+    int n = 0;
+    for (int i = 0; i < set->n_nearest && n < POINTS; i++) {
+        const bench_ray *r = &set->nearest[i];
+        hit h = accel_intersect(rs, r->o, r->d);
+        if (h.part < 0)
+            continue;
+        rs_part tmp;
+        const rs_part *p = rs_prim(rs, h.part, &tmp);
+        vec3f x = f3_madd(r->o, r->d, h.t), ng = shape_normal(p, x);
+        if (f3_dot(ng, r->d) > 0.0f)
+            ng = f3_neg(ng);
+        pr->o[n] = ray_offset(x, ng);
+        vec3f centre = f3_madd(x, ng, 5.0f);
+        for (int j = 0; j < BUNDLE; j++) {
+            vec3f d;
+            if (hemi) {
+                do
+                    d = f3(2 * bench_rnd(&seed) - 1, 2 * bench_rnd(&seed) - 1,
+                           2 * bench_rnd(&seed) - 1);
+                while (f3_dot(d, d) > 1.0f || f3_dot(d, d) < 1e-4f);
+                if (f3_dot(d, ng) < 0.0f)
+                    d = f3_neg(d);
+                pr->dist[n][j] = 3.4e38f;
+            } else {
+                vec3f q = f3_add(centre, f3(bench_rnd(&seed) - 0.5f, bench_rnd(&seed) - 0.5f,
+                                            bench_rnd(&seed) - 0.5f));
+                d = f3_sub(q, pr->o[n]);
+                pr->dist[n][j] = f3_length(d) * 0.9999f;
+            }
+            pr->d[n][j] = f3_normalize(d);
+        }
+        n++;
+    }
+    return n;
+}
+
+/* Million rays a second on one thread, the best of RUNS: one query a ray
+ * (together = 0) or the point's 64 together. */
+static double point_throughput(const rscene *rs, const point_rays *pr, int n, int hemi,
+                               int together)
+{
+    double best = 0;
+    long sink = 0;
+    for (int run = 0; run < RUNS; run++) {
+        long rays = 0;
+        double t0 = omp_get_wtime(), t;
+        do {
+            for (int i = 0; i < n; i++) {
+                if (hemi && together) {
+                    hit h[BUNDLE];
+                    accel_intersect_n(rs, pr->o[i], pr->d[i], BUNDLE, h);
+                    sink += h[BUNDLE - 1].part;
+                } else if (hemi) {
+                    for (int j = 0; j < BUNDLE; j++)
+                        sink += accel_intersect(rs, pr->o[i], pr->d[i][j]).part;
+                } else if (together) {
+                    unsigned char hidden[BUNDLE];
+                    accel_occluded_n(rs, pr->o[i], pr->d[i], pr->dist[i], BUNDLE, 0, hidden);
+                    sink += hidden[BUNDLE - 1];
+                } else {
+                    for (int j = 0; j < BUNDLE; j++)
+                        sink += accel_occluded(rs, pr->o[i], pr->d[i][j], pr->dist[i][j], 0);
+                }
+            }
+            rays += (long)n * BUNDLE;
+            t = omp_get_wtime() - t0;
+        } while (t < MIN_SECONDS);
+        double mrays = rays / t * 1e-6;
+        best = mrays > best ? mrays : best;
+    }
+    if (sink == 42)
+        printf(" ");
+    return best;
+}
+
+static void bench_points(const char *name, const zt_scene *scene)
+{
+    rscene rs;
+    zt_error err = {0};
+    if (rscene_build(&rs, scene, NULL, 0, ACCEL_EMBREE, &err) != ZT_OK) {
+        fprintf(stderr, "%s: %s\n", name, err.message);
+        return;
+    }
+    if (rs.prim_count - rs.planes[0].count - rs.planes[1].count <= 1000) {
+        rscene_free(&rs);
+        return;
+    }
+    ray_set set;
+    bench_make_rays(&rs, scene, CAMERA_RAYS, &set);
+    point_rays *pr = malloc(sizeof *pr);
+    if (!pr)
+        exit(1);
+    for (int hemi = 1; hemi >= 0; hemi--) {
+        int n = make_point_rays(&rs, &set, hemi, pr);
+        double one = point_throughput(&rs, pr, n, hemi, 0);
+        double together = point_throughput(&rs, pr, n, hemi, 1);
+        printf("%-16s %-22s %8.2f %8.2f %6.2f\n", name,
+               hemi ? "hemisphere, nearest" : "to a patch, visibility", one, together,
+               together / one);
+    }
+    free(pr);
     bench_free_rays(&set);
     rscene_free(&rs);
 }
@@ -193,17 +318,35 @@ int main(int argc, char **argv)
                 fprintf(stderr, "%s\n", err.message);
             zt_scene_release(s);
         }
+    }
+    if (count < 0)
+        fprintf(stderr, "%s: cannot list the scenes\n", dir);
+    zt_scene *synthetic[2] = {mesh_scene(), soup_scene()};
+    const char *synthetic_name[2] = {"bumpy sphere", "random soup"};
+    for (int k = 0; k < 2; k++)
+        bench_scene(synthetic_name[k], synthetic[k]);
+    printf("\nRays from one point, Embree, 1 thread: Mrays/s one at a time and %d "
+           "together\n\n%-16s %-22s %8s %8s %6s\n", BUNDLE, "scene", "rays", "one", "together",
+           "ratio");
+    for (int i = 0; i < count; i++) {
+        const char *f = names[i]->d_name;
+        size_t len = strlen(f);
+        if (len > 5 && strcmp(f + len - 5, ".json") == 0) {
+            char path[2048];
+            snprintf(path, sizeof path, "%s/%s", dir, f);
+            zt_scene *s = NULL;
+            zt_error err = {0};
+            if (zt_scene_load_file(path, &s, &err) == ZT_OK)
+                bench_points(f, s);
+            zt_scene_release(s);
+        }
         free(names[i]);
     }
     if (count >= 0)
         free(names);
-    else
-        fprintf(stderr, "%s: cannot list the scenes\n", dir);
-    zt_scene *s = mesh_scene();
-    bench_scene("bumpy sphere", s);
-    zt_scene_release(s);
-    s = soup_scene();
-    bench_scene("random soup", s);
-    zt_scene_release(s);
+    for (int k = 0; k < 2; k++) {
+        bench_points(synthetic_name[k], synthetic[k]);
+        zt_scene_release(synthetic[k]);
+    }
     return 0;
 }

@@ -43,6 +43,10 @@ int accel_occluded(const rscene *rs, vec3f o, vec3f d, float dist,
  * where the backend can. */
 void accel_intersect_n(const rscene *rs, vec3f o, const vec3f *d, int n, hit *h);
 
+/* The same for rays of their own origins o[i] (a camera's, say: nearby
+ * and nearly parallel). */
+void accel_intersect_rays(const rscene *rs, const vec3f *o, const vec3f *d, int n, hit *h);
+
 /* accel_occluded for n rays from one origin o, to distances dist[i] along
  * unit directions d[i]: hidden[i] is 1 or 0, the same answers as n calls
  * of accel_occluded.  Rays from one point towards one light are nearly

@@ -242,8 +242,8 @@ static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, con
 
 /* Nearest hits in packets, as embree_any_n: RTCRayHitN is the ray's 12
  * fields, then the hit's Ng (3), u, v, primID, geomID, instID. */
-static void embree_nearest_n(const accel *a, int layer, vec3f o, const vec3f *d, int n,
-                             const unsigned char *want, hit *h)
+static void embree_nearest_n(const accel *a, int layer, const vec3f *o, int o_step,
+                             const vec3f *d, int n, const unsigned char *want, hit *h)
 {
     const embree_accel *e = (const embree_accel *)a;
     if (e->empty[layer])
@@ -261,9 +261,10 @@ static void embree_nearest_n(const accel *a, int layer, vec3f o, const vec3f *d,
             valid[j] = i < n && want[i] ? -1 : 0;
             any |= valid[j];
             vec3f di = i < n ? d[i] : f3(0.0f, 0.0f, 1.0f);
-            RAY_N(rh, w, RN_OX, j) = o.x;
-            RAY_N(rh, w, RN_OY, j) = o.y;
-            RAY_N(rh, w, RN_OZ, j) = o.z;
+            vec3f oi = o[i < n ? i * o_step : 0];
+            RAY_N(rh, w, RN_OX, j) = oi.x;
+            RAY_N(rh, w, RN_OY, j) = oi.y;
+            RAY_N(rh, w, RN_OZ, j) = oi.z;
             RAY_N(rh, w, RN_TNEAR, j) = 0.0f;
             RAY_N(rh, w, RN_DX, j) = di.x;
             RAY_N(rh, w, RN_DY, j) = di.y;

@@ -15,11 +15,12 @@ typedef struct accel {
      * that hits something in (0, tmax[i]). */
     void (*any_n)(const struct accel *a, int layer, vec3f o, const vec3f *d, const float *tmax,
                   int n, unsigned char *hidden);
-    /* Nearest hits of n rays from one origin, where the backend has
-     * packets (NULL: it has not): lowers h[i].t and sets h[i].part as
-     * nearest does, for the rays whose want[i] is set. */
-    void (*nearest_n)(const struct accel *a, int layer, vec3f o, const vec3f *d, int n,
-                      const unsigned char *want, hit *h);
+    /* Nearest hits of n rays, where the backend has packets (NULL: it has
+     * not): ray i from o[i * o_step] (o_step 0: one origin for all) along
+     * d[i]; lowers h[i].t and sets h[i].part as nearest does, for the rays
+     * whose want[i] is set. */
+    void (*nearest_n)(const struct accel *a, int layer, const vec3f *o, int o_step,
+                      const vec3f *d, int n, const unsigned char *want, hit *h);
     void (*destroy)(struct accel *a);
     /* Whether the layer has any primitives (set by accel_build): most
      * scenes have only planes in one of them, and the call is skipped. */

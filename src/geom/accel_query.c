@@ -231,12 +231,15 @@ void accel_occluded_n(const rscene *rs, vec3f o, const vec3f *d, const float *di
     }
 }
 
-void accel_intersect_n(const rscene *rs, vec3f o, const vec3f *d, int n, hit *h)
+/* Ray i from o[i * o_step] along d[i] (accel_intersect_n,
+ * accel_intersect_rays). */
+static void intersect_n(const rscene *rs, const vec3f *o, int o_step, const vec3f *d, int n,
+                        hit *h)
 {
     const accel *a = rs->accel;
     if (__builtin_expect(rs->alpha_count != 0, 0) || n <= 1 || !a->nearest_n || a->bvh) {
         for (int i = 0; i < n; i++)
-            h[i] = accel_intersect(rs, o, d[i]);
+            h[i] = accel_intersect(rs, o[i * o_step], d[i]);
         return;
     }
     /* accel_intersect's order lane by lane: a layer's primitives, then its
@@ -244,6 +247,7 @@ void accel_intersect_n(const rscene *rs, vec3f o, const vec3f *d, int n, hit *h)
     unsigned char want[ACCEL_N_MAX];
     for (int base = 0; base < n; base += ACCEL_N_MAX) {
         int m = n - base < ACCEL_N_MAX ? n - base : ACCEL_N_MAX;
+        const vec3f *ob = o + base * o_step;
         hit *hh = h + base;
         for (int i = 0; i < m; i++) {
             hh[i] = (hit){FLT_MAX, -1};
@@ -251,11 +255,11 @@ void accel_intersect_n(const rscene *rs, vec3f o, const vec3f *d, int n, hit *h)
         }
         for (int layer = 0; layer < 2; layer++) {
             if (a->has_prims[layer])
-                a->nearest_n(a, layer, o, d + base, m, want, hh);
+                a->nearest_n(a, layer, ob, o_step, d + base, m, want, hh);
             for (int i = 0; i < m; i++) {
                 if (!want[i])
                     continue;
-                ray4 r = ray4_make(o, d[base + i]);
+                ray4 r = ray4_make(ob[i * o_step], d[base + i]);
                 planes_nearest(rs, layer, &r, &hh[i].t, &hh[i].part);
                 if (hh[i].part >= 0)
                     want[i] = 0;
@@ -265,6 +269,16 @@ void accel_intersect_n(const rscene *rs, vec3f o, const vec3f *d, int n, hit *h)
             if (hh[i].part < 0)
                 hh[i] = (hit){FLT_MAX, -1};
     }
+}
+
+void accel_intersect_n(const rscene *rs, vec3f o, const vec3f *d, int n, hit *h)
+{
+    intersect_n(rs, &o, 0, d, n, h);
+}
+
+void accel_intersect_rays(const rscene *rs, const vec3f *o, const vec3f *d, int n, hit *h)
+{
+    intersect_n(rs, o, 1, d, n, h);
 }
 
 void accel_free(struct accel *a)

@@ -44,6 +44,9 @@ static inline f4 f4_max(f4 a, f4 b)
 #endif
 }
 
+/* The lanes' sum, pairwise. */
+static inline float f4_hsum(f4 a) { return (a[0] + a[1]) + (a[2] + a[3]); }
+
 /* The smallest lane, in every lane. */
 static inline f4 f4_hmin(f4 a)
 {

@@ -95,6 +95,10 @@ typedef struct zone_quality {
     int rough_sample;   /* and that each of them takes at least */
 } zone_quality;
 
+/* Environment-map directions a point takes at a time (their cosines, and
+ * their rays as packets). */
+#define ZONE_SKY_RUN 64
+
 typedef struct zone_forest {
     zone *zones;
     int zone_count, zone_capacity;
@@ -141,6 +145,11 @@ typedef struct zone_forest {
      * scales by the share of its light that arrives. */
     vec3f *sky_dirs, *sky_weight;
     int sky_dir_count;
+    /* The same as six rows (x, y, z, then the weight's r, g, b) of
+     * sky_soa_stride floats each, padded with zeros to a multiple of
+     * ZONE_SKY_RUN: a point's cosines with all of them go four at a time. */
+    float *sky_soa;
+    size_t sky_soa_stride;
     float *sky_open;    /* ZONE_SKY_TABLE_W x ZONE_SKY_TABLE_H x rgb */
     sky_portals portals; /* the panes, where the sky's gather aims (under a
                             sky) */

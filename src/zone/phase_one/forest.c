@@ -236,6 +236,20 @@ static int sky_map_directions(zone_forest *f, const rscene *rs)
         return 0;
     }
     f->sky_dir_count = map_directions(rs, n, f->sky_dirs, f->sky_weight);
+    size_t stride = ((size_t)f->sky_dir_count + ZONE_SKY_RUN - 1) / ZONE_SKY_RUN * ZONE_SKY_RUN;
+    f->sky_soa_stride = stride;
+    f->sky_soa = calloc(6 * (stride ? stride : 1), sizeof *f->sky_soa);
+    if (!f->sky_soa) {
+        free(dirs);
+        free(weight);
+        return 0;
+    }
+    for (int k = 0; k < f->sky_dir_count; k++) {
+        const float v[6] = {f->sky_dirs[k].x,   f->sky_dirs[k].y,   f->sky_dirs[k].z,
+                            f->sky_weight[k].x, f->sky_weight[k].y, f->sky_weight[k].z};
+        for (int row = 0; row < 6; row++)
+            f->sky_soa[(size_t)row * stride + (size_t)k] = v[row];
+    }
     int count = map_directions(rs, m, dirs, weight);
     for (int j = 0; j < ZONE_SKY_TABLE_H; j++)
         for (int i = 0; i < ZONE_SKY_TABLE_W; i++) {
@@ -364,6 +378,7 @@ void zone_forest_free(zone_forest *f)
     free(f->bounce_dirs);
     free(f->sky_dirs);
     free(f->sky_weight);
+    free(f->sky_soa);
     free(f->sky_open);
     sky_portals_free(&f->portals);
     sender_tree_free(&f->light_tree);

@@ -25,6 +25,7 @@
 #include "geom/ray_offset.h"
 #include "render/share.h"
 #include "util/error.h"
+#include "util/simd4.h"
 #include "util/vec3_convert.h"
 #include "zone/light/sky_portals.h"
 #include "zone/maps/mesh_rounds.h"
@@ -94,15 +95,13 @@ static int sky_takes(const sky_part *p, int k)
     return r >= 0 && r < p->width;
 }
 
-/* Sky rays a point sends to the scene at a time. */
-#define SKY_PACKET 64
+/* Sky rays a point sends to the scene at a time (a run of the environment
+ * map's directions). */
+#define SKY_PACKET ZONE_SKY_RUN
 
 /* The share of the gather's count that a point aims at portals. */
 #define SKY_PORTAL_SHARE 2
 
-/* The sky's light through the portals that a point aims at (sky_portals.h):
- * over each, the directions whose first pane is one of its own.  A split
- * point takes its share of them, as of the gather's. */
 /* Portal directions waiting for their rays (sky_through_portals). */
 typedef struct portal_rays {
     vec3f o;
@@ -136,6 +135,9 @@ static void portal_rays_flush(zone_trace *t, portal_rays *pr, vec3 *e)
     pr->n = 0;
 }
 
+/* The sky's light through the portals that a point aims at (sky_portals.h):
+ * over each, the directions whose first pane is one of its own.  A split
+ * point takes its share of them, as of the gather's. */
 static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
                                 const sky_portal_pick *picks, int count)
 {
@@ -188,6 +190,31 @@ static void sky_gather_rays(zone_trace *t, vec3f o, const vec3f *d, int n,
                 tr[i] = f3_splat(0.0f);
 }
 
+/* The cosines of the environment map's directions k0 .. k0 + ZONE_SKY_RUN
+ * - 1 with n (0 below the horizon, and for the padding past the last)
+ * into c, their weights times them added to all's lanes (r, g, b). */
+static void sky_cosines(const zone_forest *f, vec3f n, int k0, float *c, f4 all[3])
+{
+    size_t s = f->sky_soa_stride;
+    const float *x = f->sky_soa + k0, *y = x + s, *z = y + s, *wr = z + s, *wg = wr + s,
+                *wb = wg + s;
+    f4 nx = f4_splat(n.x), ny = f4_splat(n.y), nz = f4_splat(n.z), zero = f4_splat(0.0f);
+    for (int j = 0; j < ZONE_SKY_RUN; j += 4) {
+        f4 dx, dy, dz, r, g, b;
+        memcpy(&dx, x + j, sizeof dx);
+        memcpy(&dy, y + j, sizeof dy);
+        memcpy(&dz, z + j, sizeof dz);
+        memcpy(&r, wr + j, sizeof r);
+        memcpy(&g, wg + j, sizeof g);
+        memcpy(&b, wb + j, sizeof b);
+        f4 cj = f4_max(nx * dx + ny * dy + nz * dz, zero);
+        memcpy(c + j, &cj, sizeof cj);
+        all[0] += r * cj;
+        all[1] += g * cj;
+        all[2] += b * cj;
+    }
+}
+
 vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 {
     const zone_forest *f = t->f;
@@ -204,36 +231,35 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
          * arriving (a ratio estimate: exact where nothing is in the way;
          * the share's whole is taken over every direction, which costs no
          * ray). */
-        vec3f seen = f3_splat(0.0f), all = f3_splat(0.0f);
+        vec3f seen = f3_splat(0.0f);
         sky_part share = sky_share(t->light_split, f->sky_dir_count);
-        vec3f dir[SKY_PACKET], tr[SKY_PACKET];
-        float cosine[SKY_PACKET];
-        int kept[SKY_PACKET];
-        for (int k = 0; k < f->sky_dir_count;) {
-            int rays = 0;
-            for (; k < f->sky_dir_count && rays < SKY_PACKET; k++) {
-                float c = f3_dot(nf, f->sky_dirs[k]);
-                if (c <= 0.0f)
-                    continue;
-                all = f3_madd(all, f->sky_weight[k], c);
-                if (!sky_takes(&share, k))
-                    continue;
-                dir[rays] = f->sky_dirs[k];
-                cosine[rays] = c;
-                kept[rays++] = k;
-            }
+        f4 all[3] = {f4_splat(0.0f), f4_splat(0.0f), f4_splat(0.0f)};
+        vec3f dir[ZONE_SKY_RUN], tr[ZONE_SKY_RUN];
+        float cosine[ZONE_SKY_RUN];
+        int kept[ZONE_SKY_RUN];
+        for (int k0 = 0; k0 < f->sky_dir_count; k0 += ZONE_SKY_RUN) {
+            sky_cosines(f, nf, k0, cosine, all);
+            int rays = 0, end = f->sky_dir_count - k0 < ZONE_SKY_RUN ? f->sky_dir_count - k0
+                                                                      : ZONE_SKY_RUN;
+            for (int j = 0; j < end; j++)
+                if (cosine[j] > 0.0f && sky_takes(&share, k0 + j)) {
+                    dir[rays] = f->sky_dirs[k0 + j];
+                    kept[rays++] = j;
+                }
             sky_gather_rays(t, o, dir, rays, picks, picked, tr);
             for (int i = 0; i < rays; i++)
                 if (!f3_is_black(tr[i]))
-                    seen = f3_madd(seen, f3_mul(f->sky_weight[kept[i]], tr[i]), cosine[i]);
+                    seen = f3_madd(seen, f3_mul(f->sky_weight[k0 + kept[i]], tr[i]),
+                                   cosine[kept[i]]);
         }
+        vec3f sum = f3(f4_hsum(all[0]), f4_hsum(all[1]), f4_hsum(all[2]));
         /* A split point's share of the directions stands for all of them:
          * the block's points together see what one point's would. */
         seen = f3_scale(seen, (float)share.stride / (float)share.width);
         vec3 open = sky_open_irradiance(f, nf);
-        return v3_add(portals, v3(all.x > 0.0f ? open.x * seen.x / all.x : open.x,
-                                  all.y > 0.0f ? open.y * seen.y / all.y : open.y,
-                                  all.z > 0.0f ? open.z * seen.z / all.z : open.z));
+        return v3_add(portals, v3(sum.x > 0.0f ? open.x * seen.x / sum.x : open.x,
+                                  sum.y > 0.0f ? open.y * seen.y / sum.y : open.y,
+                                  sum.z > 0.0f ? open.z * seen.z / sum.z : open.z));
     }
     vec3 tt, bb;
     v3_frame(n, &tt, &bb);

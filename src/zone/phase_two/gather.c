@@ -28,6 +28,9 @@
 #include "util/vec3_convert.h"
 #include "zone/zone.h"
 
+/* Directions whose rays are traced together. */
+#define GATHER_BATCH 64
+
 vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
                             double *inv_dist)
 {
@@ -97,30 +100,43 @@ vec3 zone_gather_irradiance(zone_trace *t, vec3f x, vec3f nf, vec3 n, int level,
     }
     vec3 sum = v3(0, 0, 0);
     double inv_sum = 0;
-    for (int j = 0; j < members * k_max; j++) {
-        int k = j % k_max;
-        double u, v;
-        r2_point(first - index + member[j / k_max] + (double)count * k, &u, &v);
-        const float uv[2] = {(float)u, (float)v};
-        vec3f d = bsdf_cosine_hemisphere(&frame, uv);
-        /* Below the geometric surface (a shading normal tilts the frame):
-         * no light from there. */
-        if (f3_dot(d, nf) <= 0.0f)
-            continue;
-        d = f3_normalize(d);
-        hit own;
-        if (kept || inv_dist) {
-            hit *h = kept ? &kept[(size_t)room[j / k_max] * k_max + k] : &own;
-            if (!kept || !reuse) {
-                *h = accel_intersect(&t->r->rs, o, d);
-                t->rays++;
-            }
-            t->first_hit = h;
-            if (h->part >= 0 && h->t > 0.0f)
-                inv_sum += 1.0 / h->t;
+    int total = members * k_max;
+    for (int j0 = 0; j0 < total; j0 += GATHER_BATCH) {
+        /* A batch's directions first, their rays traced together (packets
+         * from one point) unless the memo has their hits already. */
+        vec3f d[GATHER_BATCH];
+        hit own[GATHER_BATCH];
+        hit *h[GATHER_BATCH];
+        int n = total - j0 < GATHER_BATCH ? total - j0 : GATHER_BATCH, m = 0;
+        for (int j = j0; j < j0 + n; j++) {
+            int k = j % k_max;
+            double u, v;
+            r2_point(first - index + member[j / k_max] + (double)count * k, &u, &v);
+            const float uv[2] = {(float)u, (float)v};
+            vec3f dj = bsdf_cosine_hemisphere(&frame, uv);
+            /* Below the geometric surface (a shading normal tilts the
+             * frame): no light from there. */
+            if (f3_dot(dj, nf) <= 0.0f)
+                continue;
+            d[m] = f3_normalize(dj);
+            h[m++] = kept ? &kept[(size_t)room[j / k_max] * k_max + k] : NULL;
         }
-        sum = v3_add(sum, zone_radiance(t, o, d, level, level, ZR_NO_GLINT | ZR_NO_CAUSTIC,
-                                        NULL, 0));
+        int trace = !kept || !reuse;
+        if (trace) {
+            accel_intersect_n(&t->r->rs, o, d, m, own);
+            t->rays += (uint64_t)m;
+        }
+        for (int i = 0; i < m; i++) {
+            if (!h[i])
+                h[i] = &own[i];
+            else if (trace)
+                *h[i] = own[i];
+            t->first_hit = h[i];
+            if (inv_dist && h[i]->part >= 0 && h[i]->t > 0.0f)
+                inv_sum += 1.0 / h[i]->t;
+            sum = v3_add(sum, zone_radiance(t, o, d[i], level, level,
+                                            ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0));
+        }
     }
     t->light_split = save;
     t->gather = slot;

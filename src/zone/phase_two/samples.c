@@ -93,13 +93,16 @@ static uint32_t point_light_bits(const rscene *rs, vec3f x, vec3f n, uint64_t *r
  * signature see one smooth surface; differing ones mark an edge.  *first is
  * the ray's first hit; *curved (unless NULL) is set when the chain meets a
  * sphere, *glint (unless NULL) when it ends on a light after a specular step. */
-static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays,
-                              hit *first, int *curved, int *glint)
+/* Pixel corners whose camera rays are traced together. */
+#define CORNER_RUN 64
+
+static uint32_t signature_from(const rscene *rs, vec3f o, vec3f d, uint64_t *rays,
+                               hit *first, int *curved, int *glint, const hit *given)
 {
     uint32_t sig = 0x811c9dc5u;
     int inside = -1; /* the refractive object the chain is in */
     for (int k = 0; k <= SIGNATURE_STEPS; k++) {
-        hit h = accel_intersect(rs, o, d);
+        hit h = k == 0 && given ? *given : accel_intersect(rs, o, d);
         (*rays)++;
         if (k == 0)
             *first = h;
@@ -178,6 +181,13 @@ static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays
         }
     }
     return sig;
+}
+
+/* ... when its first hit is still to be found. */
+static uint32_t ray_signature(const rscene *rs, vec3f o, vec3f d, uint64_t *rays, hit *first,
+                              int *curved, int *glint)
+{
+    return signature_from(rs, o, d, rays, first, curved, glint, NULL);
 }
 
 typedef struct seen_lights {
@@ -369,11 +379,16 @@ static int detail_samples(const p2_ctx *c, int px, int py, uint32_t first, seen_
     const rscene *rs = &c->r->rs;
     enum { G = DETAIL_GRID, N = DETAIL_GRID * DETAIL_GRID };
     vec3f org[N], dir[N], x[N], ng[N];
-    hit h[N];
+    hit h[N], near[N];
     for (int i = 0; i < N; i++) {
-        int sx = i % G, sy = i / G;
-        cam_ray(&c->c, (float)px + (sx + 0.5f) / G, (float)py + (sy + 0.5f) / G, &org[i], &dir[i]);
-        if (ray_signature(rs, org[i], dir[i], rays, &h[i], curved, NULL) != first) {
+        /* Two grid rows' first hits are traced together. */
+        if (i % (2 * G) == 0) {
+            for (int j = i; j < i + 2 * G; j++)
+                cam_ray(&c->c, (float)px + (j % G + 0.5f) / G, (float)py + (j / G + 0.5f) / G,
+                        &org[j], &dir[j]);
+            accel_intersect_rays(rs, org + i, dir + i, 2 * G, near + i);
+        }
+        if (signature_from(rs, org[i], dir[i], rays, &h[i], curved, NULL, &near[i]) != first) {
             *edge = 1;
             return 1;
         }
@@ -759,14 +774,22 @@ int p2_row_build(const p2_ctx *c, int y, p2_row *row, uint64_t *rays)
     /* Edge pixels' grids: scratch for this row only, as the zone strategy
      * keeps every row of the image. */
     edge_grid *scratch = NULL;
-    /* Signatures at the pixel corners of this row (top and bottom). */
-    for (int k = 0; k < 2 * w1; k++) {
-        vec3f org, dir;
-        hit h;
-        cam_ray(&c->c, (float)(k % w1), (float)(y + k / w1), &org, &dir);
-        row->corner[k] = ray_signature(rs, org, dir, rays, &h, NULL, NULL);
-        row->corner_part[k] = h.part;
-        row->corner_t[k] = h.part < 0 ? -1.0f : h.t;
+    /* Signatures at the pixel corners of this row (top and bottom), the
+     * first hits of a run of neighbouring corners traced together. */
+    for (int k0 = 0; k0 < 2 * w1; k0 += CORNER_RUN) {
+        int n = 2 * w1 - k0 < CORNER_RUN ? 2 * w1 - k0 : CORNER_RUN;
+        vec3f org[CORNER_RUN], dir[CORNER_RUN];
+        hit first[CORNER_RUN];
+        for (int i = 0; i < n; i++)
+            cam_ray(&c->c, (float)((k0 + i) % w1), (float)(y + (k0 + i) / w1), &org[i], &dir[i]);
+        accel_intersect_rays(rs, org, dir, n, first);
+        for (int i = 0; i < n; i++) {
+            hit h;
+            row->corner[k0 + i] = signature_from(rs, org[i], dir[i], rays, &h, NULL, NULL,
+                                                 &first[i]);
+            row->corner_part[k0 + i] = h.part;
+            row->corner_t[k0 + i] = h.part < 0 ? -1.0f : h.t;
+        }
     }
     for (int x = 0; x < w; x++) {
         uint32_t cs[4] = {row->corner[x], row->corner[x + 1], row->corner[w1 + x],

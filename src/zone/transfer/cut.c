@@ -331,7 +331,8 @@ typedef struct see_batch {
     int rays, owners;
     vec3f dir[SEE_BATCH];
     float dist[SEE_BATCH];
-    unsigned char bg[SEE_BATCH], cast[SEE_BATCH], hidden[SEE_BATCH];
+    unsigned char bg[SEE_BATCH], cast[SEE_BATCH];
+    float seen[SEE_BATCH];
     double w[SEE_BATCH];
     int owner_first[SEE_BATCH + 1];
     cand *owner[SEE_BATCH];
@@ -340,15 +341,14 @@ typedef struct see_batch {
 
 /* Casts the batch's rays (packets from the receiver, by layer of their
  * targets) and gives each candidate its share seen, in order, as see()
- * would. */
+ * would; a ray's answer is cut_visible's (what panes on the way pass). */
 static void see_flush(gather *g, see_batch *b, double total[3])
 {
     if (!b->owners)
         return;
     for (int layer = 0; layer < 2; layer++) {
-        vec3f dir[SEE_BATCH];
+        vec3f dir[SEE_BATCH], tr[SEE_BATCH];
         float dist[SEE_BATCH];
-        unsigned char hidden[SEE_BATCH];
         int idx[SEE_BATCH], m = 0;
         for (int i = 0; i < b->rays; i++)
             if (b->bg[i] == layer && b->cast[i]) {
@@ -358,15 +358,16 @@ static void see_flush(gather *g, see_batch *b, double total[3])
             }
         if (!m)
             continue;
-        accel_occluded_n(g->rs, g->xo, dir, dist, m, layer, hidden);
+        accel_transmittance_panes_n(g->rs, g->xo, dir, dist, m, layer, tr, NULL);
         for (int k = 0; k < m; k++)
-            b->hidden[idx[k]] = hidden[k];
+            b->seen[idx[k]] = g->rs->pane_count ? (tr[k].x + tr[k].y + tr[k].z) * (1.0f / 3.0f)
+                                                : tr[k].x;
     }
     b->owner_first[b->owners] = b->rays;
     for (int o = 0; o < b->owners; o++) {
         double seen = 0;
         for (int i = b->owner_first[o]; i < b->owner_first[o + 1]; i++)
-            seen += b->w[i] * (b->cast[i] && !b->hidden[i] ? 1.0 : 0.0);
+            seen += b->w[i] * (b->cast[i] ? (double)b->seen[i] : 0.0);
         double sh = b->owner_wsum[o] > 0 ? seen / b->owner_wsum[o] : 0;
         cand *c = b->owner[o];
         c->seen = (float)sh;
@@ -379,15 +380,9 @@ static void see_flush(gather *g, see_batch *b, double total[3])
     b->rays = b->owners = 0;
 }
 
-/* see() for every candidate of c[0..count), their rays cast together.
- * Through panes a ray's answer is a fraction, and they go one by one. */
+/* see() for every candidate of c[0..count), their rays cast together. */
 static void see_all(gather *g, cand *c, int count, double total[3])
 {
-    if (g->rs->pane_count) {
-        for (int h = 0; h < count; h++)
-            see(g, &c[h], total);
-        return;
-    }
     see_batch b;
     b.rays = b.owners = 0;
     for (int h = 0; h < count; h++) {
