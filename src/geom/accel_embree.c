@@ -35,7 +35,6 @@ typedef struct embree_accel {
     /* By layer and geometry id: the parts' kinds, then mesh k at
      * GEOM_KINDS + k (in the layer the mesh is in). */
     geom_map *map[2];
-    int packet; /* native packet width (4, 8, 16), 0: none */
 } embree_accel;
 
 static inline int prim_of(const geom_map *m, unsigned prim)
@@ -202,7 +201,7 @@ static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, con
         return;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    int w = e->packet;
+    int w = a->packet;
     _Alignas(64) float ray[12 * 16];
     unsigned *bits = (unsigned *)ray;
     for (int base = 0; base < n; base += w) {
@@ -250,7 +249,7 @@ static void embree_nearest_n(const accel *a, int layer, const vec3f *o, int o_st
         return;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    int w = e->packet;
+    int w = a->packet;
     _Alignas(64) float rh[20 * 16];
     unsigned *bits = (unsigned *)rh;
     for (int base = 0; base < n; base += w) {
@@ -451,11 +450,12 @@ zt_status accel_build_embree(rscene *rs, zt_error *err)
         embree_destroy(&e->base);
         return zt_fail(err, ZT_ERR_UNSUPPORTED, "Embree failed to build the scene");
     }
-    e->packet = rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16
-                : rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) ? 8
-                : rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED) ? 4
-                                                                                             : 0;
-    if (e->packet) {
+    e->base.packet =
+        rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)  ? 16
+        : rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) ? 8
+        : rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED) ? 4
+                                                                                     : 0;
+    if (e->base.packet) {
         e->base.any_n = embree_any_n;
         e->base.nearest_n = embree_nearest_n;
     }

@@ -25,6 +25,9 @@ typedef struct accel {
     /* Whether the layer has any primitives (set by accel_build): most
      * scenes have only planes in one of them, and the call is skipped. */
     int has_prims[2];
+    /* The width of the packets any_n and nearest_n send (4, 8 or 16: the
+     * machine's native one; a test may lower it), 0 when they are NULL. */
+    int packet;
     /* The BVH backend's trees by layer, NULL for the other backends: the
      * queries walk them inline instead of through the pointers above. */
     const struct bvh_tree *bvh;
