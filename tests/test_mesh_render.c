@@ -349,6 +349,45 @@ static void test_window_room_zone(void **state)
     zt_scene_release(msh);
 }
 
+/* A forest made for one image (zt_render) leaves the meshes' last level
+ * out: their camera samples gather it from the level below.  The image is
+ * the same bytes as from a forest built whole (zt_renderer_create), in
+ * fewer rays.  Leaving out the floor plane's nodes too, or dropping the
+ * meshes' level-3 zones for want of their light, would change it. */
+static void test_one_image_forest(void **state)
+{
+    (void)state;
+    zt_scene *msh = window_room(1);
+    zt_render_options o = zt_render_options_default();
+    o.method = ZT_METHOD_ZONE;
+    o.depth = 3;
+    o.threads = 2;
+    zt_image *one = NULL, *whole = NULL;
+    zt_render_stats s1, s2;
+    zt_error err = {0};
+    if (zt_render(msh, &o, &one, &s1, &err) != ZT_OK)
+        fail_msg("%s", err.message);
+    zt_renderer *r = NULL;
+    if (zt_renderer_create(msh, &o, &r, &err) != ZT_OK ||
+        zt_renderer_render(r, &whole, &s2, &err) != ZT_OK)
+        fail_msg("%s", err.message);
+    printf("one image: %llu rays, whole forest: %llu rays\n", (unsigned long long)s1.rays,
+           (unsigned long long)s2.rays);
+    assert_int_equal(one->width, whole->width);
+    assert_memory_equal(one->pixels, whole->pixels,
+                        sizeof(float) * 3 * (size_t)one->width * (size_t)one->height);
+    assert_true(s1.rays < s2.rays);
+    assert_true(s1.zones == s2.zones);
+    /* The whole forest's preview reads every level; it stays available. */
+    zt_image *pv = zt_image_create(whole->width, whole->height);
+    assert_int_equal(zt_renderer_preview(r, pv, NULL, &err), ZT_OK);
+    zt_image_release(pv);
+    zt_renderer_release(r);
+    zt_image_release(one);
+    zt_image_release(whole);
+    zt_scene_release(msh);
+}
+
 /* ---------------------------------------------------------------------- */
 /* Furnaces */
 
@@ -624,6 +663,7 @@ int main(void)
         cmocka_unit_test(test_short_block_path),
         cmocka_unit_test(test_short_block_zone),
         cmocka_unit_test(test_window_room_zone),
+        cmocka_unit_test(test_one_image_forest),
         cmocka_unit_test(test_sphere_in_white_sky),
         cmocka_unit_test(test_closed_sphere_furnace),
         cmocka_unit_test(test_closed_sphere_first_bounce_zone),

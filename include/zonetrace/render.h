@@ -194,7 +194,10 @@ typedef struct zt_render_stats {
 } zt_render_stats;
 
 /* Renders the scene through its camera into a new linear image (*out, the
- * caller's).  stats may be NULL. */
+ * caller's).  stats may be NULL.  The zone tracer's forest here serves
+ * this one image: Phase One leaves out what its Phase Two does not read
+ * (the last level on meshes, docs/zone-tracer.md); zt_renderer_create
+ * builds it whole, for previews and zt_renderer_save_forest. */
 zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
                     zt_image **out, zt_render_stats *stats, zt_error *err);
 

@@ -96,8 +96,8 @@ void zt_renderer_release(zt_renderer *r)
 }
 
 static zt_status renderer_create(const zt_scene *scene, const zt_render_options *o,
-                                 double deadline, zt_renderer **out, zt_render_stats *stats,
-                                 zt_error *err)
+                                 double deadline, int one_image, zt_renderer **out,
+                                 zt_render_stats *stats, zt_error *err)
 {
     *out = NULL;
     zt_status st = check_options(scene, o, err);
@@ -124,6 +124,7 @@ static zt_status renderer_create(const zt_scene *scene, const zt_render_options 
     r->depth_asked = o->depth;
     r->memory_estimate = need;
     r->deadline = deadline;
+    r->one_image = one_image;
     st = rscene_build(&r->rs, r->scene, o->lights_off, o->lights_off_count,
                       render_accel_kind(r->scene->part_count +
                                         scene_mesh_triangles(r->scene)), err);
@@ -145,7 +146,7 @@ static double deadline_from(const zt_render_options *o, double t0)
 zt_status zt_renderer_create(const zt_scene *scene, const zt_render_options *o,
                              zt_renderer **out, zt_error *err)
 {
-    return renderer_create(scene, o, deadline_from(o, render_clock()), out, NULL, err);
+    return renderer_create(scene, o, deadline_from(o, render_clock()), 0, out, NULL, err);
 }
 
 zt_status zt_renderer_set_camera(zt_renderer *r, const zt_camera *camera,
@@ -248,7 +249,7 @@ zt_status zt_render(const zt_scene *scene, const zt_render_options *options,
     *out = NULL;
     double t0 = render_clock();
     zt_renderer *r;
-    zt_status st = renderer_create(scene, options, deadline_from(options, t0), &r, stats, err);
+    zt_status st = renderer_create(scene, options, deadline_from(options, t0), 1, &r, stats, err);
     if (st != ZT_OK)
         return st;
     double prepared = render_clock();

@@ -49,6 +49,9 @@ struct zt_renderer {
     uint64_t memory_estimate;   /* bytes: image, scene copy, acceleration
                                    (render/memory.h); the zone tracer adds
                                    its forest's */
+    int one_image;              /* made by zt_render for one image: the
+                                   forest need hold only what its Phase Two
+                                   reads (no preview, not saved) */
 };
 
 /* Where path-traced samples go: running sums in double (continued sample

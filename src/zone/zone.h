@@ -105,6 +105,9 @@ typedef struct zone_forest {
     uint64_t pruned;
     surface_nodes sn;
     int map_levels;     /* irradiance levels E_0 .. E_{map_levels-1} */
+    int top_gathered;   /* the last level left out (0) on the nodes of
+                           meshes, whose camera samples gather it from the
+                           level below: a forest for one image (phase_one.c) */
     float *e;           /* [level][node][rgb] */
     /* What e holds of light that came from the lights by way of specular
      * surfaces alone (caustic photons, glint images), kept apart where

@@ -175,6 +175,9 @@ zt_status zone_accumulate(zt_renderer *r, zt_image *sum, zt_render_stats *stats,
 zt_status zone_preview(zt_renderer *r, zt_image *sum, zt_render_stats *stats, zt_error *err)
 {
     zone_forest *f = (zone_forest *)r->forest;
+    if (f->top_gathered)
+        return zt_fail(err, ZT_ERR_ARGUMENT,
+                       "this forest was built for one image (zt_render): no preview");
     const zt_render_options *o = &r->options;
     double t0 = render_clock();
     p2_ctx c;

@@ -275,6 +275,9 @@ zt_status zt_renderer_save_forest(const zt_renderer *r, const char *path, zt_err
     if (r->options.method != ZT_METHOD_ZONE || !r->forest)
         return zt_fail(err, ZT_ERR_ARGUMENT,
                        "only the zone tracer has a forest to save (method path)");
+    if (((const zone_forest *)r->forest)->top_gathered)
+        return zt_fail(err, ZT_ERR_ARGUMENT,
+                       "this forest was built for one image (zt_render) and cannot be saved");
     return forest_save((const zone_forest *)r->forest, r, path, err);
 }
 

@@ -651,6 +651,17 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
     }
     surfaces_present(rs, present);
     incident_flux(f, rs, flux);
+    /* Surfaces whose last level was left out (meshes: top_gathered) are
+     * bounded at the level above it by all the light of that level. */
+    unsigned char *gathered = f->top_gathered ? calloc((size_t)ns + 1, 1) : NULL;
+    if (f->top_gathered && !gathered) {
+        free(present);
+        free(flux);
+        free(level_power);
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the zones");
+    }
+    for (int prim = rs->part_count; gathered && prim < rs->prim_count; prim++)
+        gathered[zone_surface_of(rs, prim)] = 1;
     /* The sky and the sun are no zones, but what they send is light of
      * level 0: as much as all the surfaces could take in. */
     double sky_lum = f3_luminance(rs->sky);
@@ -711,8 +722,10 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
                      * by all the light of the level below. */
                     arriving = level_power[level - 1];
                 else
-                    arriving = level - 1 < f->map_levels ? flux[(size_t)(level - 1) * ns + s]
-                                                         : level_power[level - 1];
+                    arriving = level - 1 < f->map_levels &&
+                                       !(gathered && gathered[s] && level == f->map_levels)
+                                   ? flux[(size_t)(level - 1) * ns + s]
+                                   : level_power[level - 1];
                 zone z = {s, (uint8_t)lobe_kind[k], (uint8_t)level,
                           (float)(arriving * o->weight[k] * f3_max(o->color))};
                 if (!(z.power > 0))
@@ -729,6 +742,7 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
     free(present);
     free(flux);
     free(level_power);
+    free(gathered);
     if (!ok)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the zones");
     return ZT_OK;

@@ -529,12 +529,17 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
     int threads = render_thread_count(o->threads);
     const volatile sig_atomic_t *stop = o->stop;
     int quit = 0;
+    /* A forest for one image leaves the last level out on meshes: their
+     * camera samples gather it from the level below, and nothing else
+     * reads it (zone.h, top_gathered). */
+    int skip_meshes = f->top_gathered && level == f->map_levels - 1;
     /* Progress in nodes settled (computed or read: each in one pass). */
     double owned = 0;
     for (int k = 0; k < sn->node_count; k++) {
         /* (A member is settled by whoever settles its leader.) */
         int32_t lead = level > 0 ? node_group_lead(ng, k) : -1;
-        owned += sn->live[k] && share_owns(o, (lead >= 0 ? lead : k) / SHARE_BLOCK);
+        owned += sn->live[k] && share_owns(o, (lead >= 0 ? lead : k) / SHARE_BLOCK) &&
+                 !(skip_meshes && zone_gathers(rs, sn->prim_of[k]));
     }
     char stage[48];
     snprintf(stage, sizeof stage, "phase one %d/%d", level + 1, f->map_levels);
@@ -559,7 +564,8 @@ static zt_status build_level(zone_forest *f, const zt_renderer *r, int level,
                     quit = 1;
                     continue;
                 }
-                if (!sn->live[k] || !share_owns(o, k / SHARE_BLOCK))
+                if (!sn->live[k] || !share_owns(o, k / SHARE_BLOCK) ||
+                    (skip_meshes && zone_gathers(rs, sn->prim_of[k])))
                     continue;
                 /* A group's members are computed with its leader, in the
                  * first pass (direct light keeps a cut each). */
@@ -737,6 +743,7 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
          * time Phase Two will need; one that does not is abandoned. */
         double phase_two = 0;
         int built = 0;
+        f->top_gathered = r->one_image && r->rs.mesh_count > 0;
         for (int level = 0; level < f->map_levels; level++) {
             double t0 = render_clock();
             if (level > 0)
@@ -764,7 +771,9 @@ zt_status zone_phase_one(zone_forest *f, zt_renderer *r, zt_error *err)
         if (st != ZT_OK)
             return st;
         if (built < f->map_levels) {
-            /* E_0 .. E_{built-1} carry depth `built`; depth 1 needs none. */
+            /* E_0 .. E_{built-1} carry depth `built`; depth 1 needs none.
+             * (Their last level was built whole.) */
+            f->top_gathered = 0;
             r->options.depth = built > 1 ? built : 1;
             f->map_levels = built > 1 ? built : 0;
         }
