@@ -294,6 +294,27 @@ static void scenes_dir(int argc, char **argv, char *out, size_t size)
         snprintf(out, size, "scenes");
 }
 
+/* fn on each scene file of the listing (names, count: scandir's). */
+static void each_scene(const char *dir, struct dirent **names, int count,
+                       void (*fn)(const char *, const zt_scene *))
+{
+    for (int i = 0; i < count; i++) {
+        const char *f = names[i]->d_name;
+        size_t len = strlen(f);
+        if (len <= 5 || strcmp(f + len - 5, ".json") != 0)
+            continue;
+        char path[2048];
+        snprintf(path, sizeof path, "%s/%s", dir, f);
+        zt_scene *s = NULL;
+        zt_error err = {0};
+        if (zt_scene_load_file(path, &s, &err) == ZT_OK)
+            fn(f, s);
+        else
+            fprintf(stderr, "%s\n", err.message);
+        zt_scene_release(s);
+    }
+}
+
 int main(int argc, char **argv)
 {
     char dir[1024];
@@ -304,23 +325,9 @@ int main(int argc, char **argv)
            "backend", "build", "near 1T", "near NT", "any 1T", "any NT");
     struct dirent **names;
     int count = scandir(dir, &names, NULL, alphasort);
-    for (int i = 0; i < count; i++) {
-        const char *f = names[i]->d_name;
-        size_t len = strlen(f);
-        if (len > 5 && strcmp(f + len - 5, ".json") == 0) {
-            char path[2048];
-            snprintf(path, sizeof path, "%s/%s", dir, f);
-            zt_scene *s = NULL;
-            zt_error err = {0};
-            if (zt_scene_load_file(path, &s, &err) == ZT_OK)
-                bench_scene(f, s);
-            else
-                fprintf(stderr, "%s\n", err.message);
-            zt_scene_release(s);
-        }
-    }
     if (count < 0)
         fprintf(stderr, "%s: cannot list the scenes\n", dir);
+    each_scene(dir, names, count, bench_scene);
     zt_scene *synthetic[2] = {mesh_scene(), soup_scene()};
     const char *synthetic_name[2] = {"bumpy sphere", "random soup"};
     for (int k = 0; k < 2; k++)
@@ -328,25 +335,14 @@ int main(int argc, char **argv)
     printf("\nRays from one point, Embree, 1 thread: Mrays/s one at a time and %d "
            "together\n\n%-16s %-22s %8s %8s %6s\n", BUNDLE, "scene", "rays", "one", "together",
            "ratio");
-    for (int i = 0; i < count; i++) {
-        const char *f = names[i]->d_name;
-        size_t len = strlen(f);
-        if (len > 5 && strcmp(f + len - 5, ".json") == 0) {
-            char path[2048];
-            snprintf(path, sizeof path, "%s/%s", dir, f);
-            zt_scene *s = NULL;
-            zt_error err = {0};
-            if (zt_scene_load_file(path, &s, &err) == ZT_OK)
-                bench_points(f, s);
-            zt_scene_release(s);
-        }
-        free(names[i]);
-    }
-    if (count >= 0)
-        free(names);
+    each_scene(dir, names, count, bench_points);
     for (int k = 0; k < 2; k++) {
         bench_points(synthetic_name[k], synthetic[k]);
         zt_scene_release(synthetic[k]);
     }
+    for (int i = 0; i < count; i++)
+        free(names[i]);
+    if (count >= 0)
+        free(names);
     return 0;
 }

@@ -191,8 +191,37 @@ static int embree_any(const accel *a, int layer, vec3f o, vec3f d, float tmax)
     return r.tfar < 0.0f;
 }
 
-/* Packets of the machine's native width (its `packet` lanes: 4, 8 or
- * 16), laid out as RTCRay4/8/16 are; lanes already hidden are left out. */
+/* Lanes 0 .. w-1 of a packet laid out as RTCRay4/8/16 are (the ray's
+ * fields, each w floats): lane j the ray from o[j * o_step] along d[j] up
+ * to tfar[j], valid where on[j] (lanes m and past are not).  Returns
+ * whether any lane is valid. */
+static int packet_fill(float *ray, int *valid, int w, int m, const vec3f *o, int o_step,
+                       const vec3f *d, const float *tfar, const unsigned char *on)
+{
+    unsigned *bits = (unsigned *)ray;
+    int any = 0;
+    for (int j = 0; j < w; j++) {
+        valid[j] = j < m && on[j] ? -1 : 0;
+        any |= valid[j];
+        vec3f oj = o[j < m ? j * o_step : 0], dj = j < m ? d[j] : f3(0.0f, 0.0f, 1.0f);
+        RAY_N(ray, w, RN_OX, j) = oj.x;
+        RAY_N(ray, w, RN_OY, j) = oj.y;
+        RAY_N(ray, w, RN_OZ, j) = oj.z;
+        RAY_N(ray, w, RN_TNEAR, j) = 0.0f;
+        RAY_N(ray, w, RN_DX, j) = dj.x;
+        RAY_N(ray, w, RN_DY, j) = dj.y;
+        RAY_N(ray, w, RN_DZ, j) = dj.z;
+        RAY_N(ray, w, RN_TIME, j) = 0.0f;
+        RAY_N(ray, w, RN_TFAR, j) = j < m ? tfar[j] : 0.0f;
+        bits[9 * w + j] = 0xffffffffu; /* mask */
+        bits[10 * w + j] = (unsigned)j; /* id */
+        bits[11 * w + j] = 0;          /* flags */
+    }
+    return any;
+}
+
+/* Packets of the machine's native width (a->packet: 4, 8 or 16); lanes
+ * already hidden are left out. */
 static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, const float *tmax,
                          int n, unsigned char *hidden)
 {
@@ -203,29 +232,16 @@ static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, con
     rtcInitIntersectContext(&ctx);
     int w = a->packet;
     _Alignas(64) float ray[12 * 16];
-    unsigned *bits = (unsigned *)ray;
     for (int base = 0; base < n; base += w) {
         _Alignas(64) int valid[16];
-        int any = 0;
-        for (int j = 0; j < w; j++) {
-            int i = base + j;
-            valid[j] = i < n && !hidden[i] ? -1 : 0;
-            any |= valid[j];
-            vec3f di = i < n ? d[i] : f3(0.0f, 0.0f, 1.0f);
-            RAY_N(ray, w, RN_OX, j) = o.x;
-            RAY_N(ray, w, RN_OY, j) = o.y;
-            RAY_N(ray, w, RN_OZ, j) = o.z;
-            RAY_N(ray, w, RN_TNEAR, j) = 0.0f;
-            RAY_N(ray, w, RN_DX, j) = di.x;
-            RAY_N(ray, w, RN_DY, j) = di.y;
-            RAY_N(ray, w, RN_DZ, j) = di.z;
-            RAY_N(ray, w, RN_TIME, j) = 0.0f;
-            RAY_N(ray, w, RN_TFAR, j) = i < n ? below(tmax[i]) : 0.0f;
-            bits[9 * w + j] = 0xffffffffu; /* mask */
-            bits[10 * w + j] = (unsigned)j; /* id */
-            bits[11 * w + j] = 0;          /* flags */
+        int m = n - base < w ? n - base : w;
+        float far[16];
+        unsigned char on[16];
+        for (int j = 0; j < m; j++) {
+            on[j] = !hidden[base + j];
+            far[j] = below(tmax[base + j]);
         }
-        if (!any)
+        if (!packet_fill(ray, valid, w, m, &o, 0, d + base, far, on))
             continue;
         if (w == 16)
             rtcOccluded16(valid, e->scene[layer], &ctx, (struct RTCRay16 *)ray);
@@ -233,7 +249,7 @@ static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, con
             rtcOccluded8(valid, e->scene[layer], &ctx, (struct RTCRay8 *)ray);
         else
             rtcOccluded4(valid, e->scene[layer], &ctx, (struct RTCRay4 *)ray);
-        for (int j = 0; j < w && base + j < n; j++)
+        for (int j = 0; j < m; j++)
             if (valid[j] && RAY_N(ray, w, RN_TFAR, j) < 0.0f)
                 hidden[base + j] = 1;
     }
@@ -254,25 +270,13 @@ static void embree_nearest_n(const accel *a, int layer, const vec3f *o, int o_st
     unsigned *bits = (unsigned *)rh;
     for (int base = 0; base < n; base += w) {
         _Alignas(64) int valid[16];
-        int any = 0;
+        int m = n - base < w ? n - base : w;
+        float far[16];
+        for (int j = 0; j < m; j++)
+            far[j] = h[base + j].t;
+        int any = packet_fill(rh, valid, w, m, o + base * o_step, o_step, d + base, far,
+                              want + base);
         for (int j = 0; j < w; j++) {
-            int i = base + j;
-            valid[j] = i < n && want[i] ? -1 : 0;
-            any |= valid[j];
-            vec3f di = i < n ? d[i] : f3(0.0f, 0.0f, 1.0f);
-            vec3f oi = o[i < n ? i * o_step : 0];
-            RAY_N(rh, w, RN_OX, j) = oi.x;
-            RAY_N(rh, w, RN_OY, j) = oi.y;
-            RAY_N(rh, w, RN_OZ, j) = oi.z;
-            RAY_N(rh, w, RN_TNEAR, j) = 0.0f;
-            RAY_N(rh, w, RN_DX, j) = di.x;
-            RAY_N(rh, w, RN_DY, j) = di.y;
-            RAY_N(rh, w, RN_DZ, j) = di.z;
-            RAY_N(rh, w, RN_TIME, j) = 0.0f;
-            RAY_N(rh, w, RN_TFAR, j) = i < n ? h[i].t : 0.0f;
-            bits[9 * w + j] = 0xffffffffu;
-            bits[10 * w + j] = (unsigned)j;
-            bits[11 * w + j] = 0;
             bits[18 * w + j] = RTC_INVALID_GEOMETRY_ID; /* geomID */
             bits[19 * w + j] = RTC_INVALID_GEOMETRY_ID; /* instID */
         }
@@ -284,7 +288,7 @@ static void embree_nearest_n(const accel *a, int layer, const vec3f *o, int o_st
             rtcIntersect8(valid, e->scene[layer], &ctx, (struct RTCRayHit8 *)rh);
         else
             rtcIntersect4(valid, e->scene[layer], &ctx, (struct RTCRayHit4 *)rh);
-        for (int j = 0; j < w && base + j < n; j++) {
+        for (int j = 0; j < m; j++) {
             unsigned geom = bits[18 * w + j];
             if (!valid[j] || geom == RTC_INVALID_GEOMETRY_ID)
                 continue;
