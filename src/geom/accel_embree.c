@@ -195,10 +195,19 @@ static int embree_any(const accel *a, int layer, vec3f o, vec3f d, float tmax)
  * fields, each w floats): lane j the ray from o[j * o_step] along d[j] up
  * to tfar[j], valid where on[j] (lanes m and past are not).  Returns
  * whether any lane is valid. */
-static int packet_fill(float *ray, int *valid, int w, int m, const vec3f *o, int o_step,
+/* A packet's storage: a ray and hit of 16 lanes (Embree's RTCRayHit16,
+ * one instance level), read as floats or as integers. */
+_Static_assert(RTC_MAX_INSTANCE_LEVEL_COUNT == 1, "a packet holds one instance id a lane");
+typedef union packet {
+    float f[20 * 16];
+    unsigned u[20 * 16];
+} packet;
+
+static int packet_fill(packet *p, int *valid, int w, int m, const vec3f *o, int o_step,
                        const vec3f *d, const float *tfar, const unsigned char *on)
 {
-    unsigned *bits = (unsigned *)ray;
+    float *ray = p->f;
+    unsigned *bits = p->u;
     int any = 0;
     for (int j = 0; j < w; j++) {
         valid[j] = j < m && on[j] ? -1 : 0;
@@ -231,7 +240,7 @@ static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, con
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     int w = a->packet;
-    _Alignas(64) float ray[12 * 16];
+    _Alignas(64) packet ray;
     for (int base = 0; base < n; base += w) {
         _Alignas(64) int valid[16];
         int m = n - base < w ? n - base : w;
@@ -241,16 +250,16 @@ static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, con
             on[j] = !hidden[base + j];
             far[j] = below(tmax[base + j]);
         }
-        if (!packet_fill(ray, valid, w, m, &o, 0, d + base, far, on))
+        if (!packet_fill(&ray, valid, w, m, &o, 0, d + base, far, on))
             continue;
         if (w == 16)
-            rtcOccluded16(valid, e->scene[layer], &ctx, (struct RTCRay16 *)ray);
+            rtcOccluded16(valid, e->scene[layer], &ctx, (struct RTCRay16 *)&ray);
         else if (w == 8)
-            rtcOccluded8(valid, e->scene[layer], &ctx, (struct RTCRay8 *)ray);
+            rtcOccluded8(valid, e->scene[layer], &ctx, (struct RTCRay8 *)&ray);
         else
-            rtcOccluded4(valid, e->scene[layer], &ctx, (struct RTCRay4 *)ray);
+            rtcOccluded4(valid, e->scene[layer], &ctx, (struct RTCRay4 *)&ray);
         for (int j = 0; j < m; j++)
-            if (valid[j] && RAY_N(ray, w, RN_TFAR, j) < 0.0f)
+            if (valid[j] && RAY_N(ray.f, w, RN_TFAR, j) < 0.0f)
                 hidden[base + j] = 1;
     }
 }
@@ -266,15 +275,15 @@ static void embree_nearest_n(const accel *a, int layer, const vec3f *o, int o_st
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     int w = a->packet;
-    _Alignas(64) float rh[20 * 16];
-    unsigned *bits = (unsigned *)rh;
+    _Alignas(64) packet rh;
+    unsigned *bits = rh.u;
     for (int base = 0; base < n; base += w) {
         _Alignas(64) int valid[16];
         int m = n - base < w ? n - base : w;
         float far[16];
         for (int j = 0; j < m; j++)
             far[j] = h[base + j].t;
-        int any = packet_fill(rh, valid, w, m, o + base * o_step, o_step, d + base, far,
+        int any = packet_fill(&rh, valid, w, m, o + base * o_step, o_step, d + base, far,
                               want + base);
         for (int j = 0; j < w; j++) {
             bits[18 * w + j] = RTC_INVALID_GEOMETRY_ID; /* geomID */
@@ -283,16 +292,16 @@ static void embree_nearest_n(const accel *a, int layer, const vec3f *o, int o_st
         if (!any)
             continue;
         if (w == 16)
-            rtcIntersect16(valid, e->scene[layer], &ctx, (struct RTCRayHit16 *)rh);
+            rtcIntersect16(valid, e->scene[layer], &ctx, (struct RTCRayHit16 *)&rh);
         else if (w == 8)
-            rtcIntersect8(valid, e->scene[layer], &ctx, (struct RTCRayHit8 *)rh);
+            rtcIntersect8(valid, e->scene[layer], &ctx, (struct RTCRayHit8 *)&rh);
         else
-            rtcIntersect4(valid, e->scene[layer], &ctx, (struct RTCRayHit4 *)rh);
+            rtcIntersect4(valid, e->scene[layer], &ctx, (struct RTCRayHit4 *)&rh);
         for (int j = 0; j < m; j++) {
             unsigned geom = bits[18 * w + j];
             if (!valid[j] || geom == RTC_INVALID_GEOMETRY_ID)
                 continue;
-            h[base + j].t = RAY_N(rh, w, RN_TFAR, j);
+            h[base + j].t = RAY_N(rh.f, w, RN_TFAR, j);
             h[base + j].part = prim_of(&e->map[layer][geom], bits[17 * w + j]);
         }
     }

@@ -560,6 +560,24 @@ static int clips_every_point(const direct_ctx *c)
 
 /* Pieces whose rays' results by_rays keeps, to weigh the smaller side. */
 #define BY_RAYS_KEPT 1024
+/* Rays by_rays casts together. */
+#define BY_RAYS_PACKET 64
+
+/* Casts n rays from xo (unit directions dir, distances reach) together and
+ * marks the pieces ray_of[i] they see in seen; returns how many see. */
+static int by_rays_cast(const rscene *rs, vec3f xo, int background, const vec3f *dir,
+                        const float *reach, const int *ray_of, int n, vec3f *seen)
+{
+    unsigned char hidden[BY_RAYS_PACKET];
+    accel_occluded_n(rs, xo, dir, reach, n, background, hidden);
+    int count = 0;
+    for (int i = 0; i < n; i++)
+        if (!hidden[i]) {
+            seen[ray_of[i]] = f3_splat(1.0f);
+            count++;
+        }
+    return count;
+}
 
 static _Thread_local uint64_t rays_cast;
 
@@ -660,9 +678,9 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
     /* Without panes a ray's answer is 0 or 1, and the point's rays go
      * together as packets (nearly parallel: they all aim at the light). */
     int packed = keep && !c->rs->pane_count;
-    vec3f dir[BY_RAYS_KEPT];
-    float reach[BY_RAYS_KEPT];
-    int ray_of[BY_RAYS_KEPT], rays = 0;
+    vec3f dir[BY_RAYS_PACKET];
+    float reach[BY_RAYS_PACKET];
+    int ray_of[BY_RAYS_PACKET], rays = 0;
     fan_start(&w, f, p, m);
     for (int g = 0; fan_next(&w, q); g++) {
         vec3f s = f3_splat(0.0f);
@@ -689,16 +707,13 @@ static vec3 by_rays(const direct_ctx *c, const zprim *lp, const light_frame *f, 
         }
         if (keep)
             seen[at++] = s;
+        if (rays == BY_RAYS_PACKET) {
+            seen_count += by_rays_cast(c->rs, xo, lp->background, dir, reach, ray_of, rays, seen);
+            rays = 0;
+        }
     }
-    if (rays) {
-        unsigned char hidden[BY_RAYS_KEPT];
-        accel_occluded_n(c->rs, xo, dir, reach, rays, lp->background, hidden);
-        for (int i = 0; i < rays; i++)
-            if (!hidden[i]) {
-                seen[ray_of[i]] = f3_splat(1.0f);
-                seen_count += 1.0;
-            }
-    }
+    if (rays)
+        seen_count += by_rays_cast(c->rs, xo, lp->background, dir, reach, ray_of, rays, seen);
     if (!keep)
         return e;
     if (seen_count == 0)

@@ -643,21 +643,28 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
     unsigned char *present = calloc((size_t)ns + 1, 1);
     double *flux = calloc((size_t)(f->map_levels + 1) * ns + 1, sizeof *flux);
     double *level_power = calloc((size_t)depth + 2, sizeof *level_power);
-    if (!present || !flux || !level_power) {
+    /* The same with the pruned zones' power too: what a level sends at
+     * most, whatever the image keeps of it. */
+    double *level_sent = calloc((size_t)depth + 2, sizeof *level_sent);
+    if (!present || !flux || !level_power || !level_sent) {
         free(present);
         free(flux);
         free(level_power);
+        free(level_sent);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the zones");
     }
     surfaces_present(rs, present);
     incident_flux(f, rs, flux);
     /* Surfaces whose last level was left out (meshes: top_gathered) are
-     * bounded at the level above it by all the light of that level. */
+     * bounded at the level above it by all the light that level sends,
+     * which is no less than what arrives at any one of them: no zone the
+     * nodes' flux would keep is lost. */
     unsigned char *gathered = f->top_gathered ? calloc((size_t)ns + 1, 1) : NULL;
     if (f->top_gathered && !gathered) {
         free(present);
         free(flux);
         free(level_power);
+        free(level_sent);
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the zones");
     }
     for (int prim = rs->part_count; gathered && prim < rs->prim_count; prim++)
@@ -680,6 +687,7 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
         if (rs->planes[0].count + rs->planes[1].count > 0)
             level_power[0] = INFINITY; /* an infinite plane under the sky */
     }
+    level_sent[0] = level_power[0];
     int ok = 1;
     /* Roots: every light primitive that emits. */
     for (int i = 0; i < rs->light_count && ok; i++) {
@@ -692,6 +700,7 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
                           3.14159265358979 * area)};
         if (!(z.power > 0))
             continue;
+        level_sent[0] += z.power;
         if (z.power <= cutoff) {
             f->pruned++;
             continue;
@@ -722,14 +731,15 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
                      * by all the light of the level below. */
                     arriving = level_power[level - 1];
                 else
-                    arriving = level - 1 < f->map_levels &&
-                                       !(gathered && gathered[s] && level == f->map_levels)
-                                   ? flux[(size_t)(level - 1) * ns + s]
-                                   : level_power[level - 1];
+                    arriving = gathered && gathered[s] && level == f->map_levels
+                                   ? level_sent[level - 1]
+                               : level - 1 < f->map_levels ? flux[(size_t)(level - 1) * ns + s]
+                                                           : level_power[level - 1];
                 zone z = {s, (uint8_t)lobe_kind[k], (uint8_t)level,
                           (float)(arriving * o->weight[k] * f3_max(o->color))};
                 if (!(z.power > 0))
                     continue;
+                level_sent[level] += z.power;
                 if (z.power <= cutoff) {
                     f->pruned++;
                     continue;
@@ -742,6 +752,7 @@ zt_status zone_forest_zones(zone_forest *f, const zt_renderer *r, zt_error *err)
     free(present);
     free(flux);
     free(level_power);
+    free(level_sent);
     free(gathered);
     if (!ok)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the zones");

@@ -401,7 +401,9 @@ static void see_all(gather *g, cand *c, int count, double total[3])
         see_target tg[SEE_TARGETS_MAX];
         double wsum;
         int m = seen_targets(g, node, tg, &wsum);
-        if (b.rays + m > SEE_BATCH)
+        /* (A candidate may bring no ray: a leaf whose facing elements are
+         * dark.  The batch is full at SEE_BATCH candidates too.) */
+        if (b.rays + m > SEE_BATCH || b.owners == SEE_BATCH)
             see_flush(g, &b, total);
         c[h].seen = -2;
         b.owner[b.owners] = &c[h];
