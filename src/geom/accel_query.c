@@ -184,7 +184,7 @@ static void prims_any_n(const accel *a, int layer, vec3f o, const vec3f *d, cons
 {
     if (!a->has_prims[layer])
         return;
-    if (a->any_n && !a->bvh) {
+    if (a->any_n) {
         a->any_n(a, layer, o, d, tmax, n, hidden);
         return;
     }
@@ -237,7 +237,7 @@ static void intersect_n(const rscene *rs, const vec3f *o, int o_step, const vec3
                         hit *h)
 {
     const accel *a = rs->accel;
-    if (__builtin_expect(rs->alpha_count != 0, 0) || n <= 1 || !a->nearest_n || a->bvh) {
+    if (__builtin_expect(rs->alpha_count != 0, 0) || n <= 1 || !a->nearest_n) {
         for (int i = 0; i < n; i++)
             h[i] = accel_intersect(rs, o[i * o_step], d[i]);
         return;
