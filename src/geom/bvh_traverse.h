@@ -52,6 +52,11 @@ static inline f4 bvh_inverse(vec3f d)
 static inline void bvh_ray_init(bvh_ray *b, const ray4 *r, vec3f o, vec3f d)
 {
     f4 inv = bvh_inverse(d);
+    /* 1/d keeps d's sign bit (a zero becomes +-1e20), so the corners are
+     * chosen by d's own sign bits: the first node's loads then need not
+     * wait for the division. */
+    f4 dv = {d.x, d.y, d.z, 1.0f};
+    int negative = i4_bits((i4)dv < i4_splat(0));
     b->r = *r;
     b->ix = f4_splat(inv[0]);
     b->iy = f4_splat(inv[1]);
@@ -66,7 +71,7 @@ static inline void bvh_ray_init(bvh_ray *b, const ray4 *r, vec3f o, vec3f d)
         {0, 64, 32, 48, 16, 80}, {48, 64, 32, 0, 16, 80},
         {0, 16, 80, 48, 64, 32}, {48, 16, 80, 0, 64, 32},
         {0, 64, 80, 48, 16, 32}, {48, 64, 80, 0, 16, 32}};
-    b->corner = corners[i4_bits(inv < f4_splat(0.0f)) & 7];
+    b->corner = corners[negative & 7];
 }
 
 static inline f4 bvh_bound(const bvh4_node *n, uint32_t offset)
