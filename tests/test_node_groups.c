@@ -19,6 +19,7 @@
 
 #include "render/render_internal.h"
 #include "scene/mesh.h"
+#include "zone/maps/mesh_sheet.h"
 #include "zone/maps/node_groups.h"
 #include "zone/transfer/transfer.h"
 #include "zone/zone.h"
@@ -240,9 +241,75 @@ static void test_forest_the_same_on_any_thread_count(void **state)
     zt_scene_release(s3);
 }
 
+/* A faceted sheet, as a file with a normal per face gives it: every
+ * triangle has its own three vertices (4 x 4 squares of side 1 on y = 0),
+ * and the last column of squares is folded up by 60 degrees (its normals
+ * say so; its positions stay, which the walk does not look at).  Copies at
+ * one position are one point of the surface: a walk crosses from facet to
+ * facet through them, and stops at the fold. */
+#define FACETS 4
+static void test_sheet_walk_crosses_split_vertices(void **state)
+{
+    (void)state;
+    enum { TRIS = 2 * FACETS * FACETS, VERTS = 3 * TRIS };
+    float pos[3 * VERTS + 1], nrm[3 * VERTS];
+    uint32_t index[3 * TRIS];
+    int folded[VERTS];
+    int v = 0;
+    for (int i = 0; i < FACETS; i++)
+        for (int j = 0; j < FACETS; j++) {
+            const int corner[2][3][2] = {{{0, 0}, {0, 1}, {1, 1}}, {{0, 0}, {1, 1}, {1, 0}}};
+            for (int t = 0; t < 2; t++)
+                for (int c = 0; c < 3; c++, v++) {
+                    pos[3 * v] = (float)(i + corner[t][c][0]);
+                    pos[3 * v + 1] = 0.0f;
+                    pos[3 * v + 2] = (float)(j + corner[t][c][1]);
+                    folded[v] = i == FACETS - 1;
+                    nrm[3 * v] = folded[v] ? -0.8660254f : 0.0f;
+                    nrm[3 * v + 1] = folded[v] ? 0.5f : 1.0f;
+                    nrm[3 * v + 2] = 0.0f;
+                    index[v] = (uint32_t)v;
+                }
+        }
+    pos[3 * VERTS] = 0.0f;
+    mesh m = {.vertex_count = VERTS, .triangle_count = TRIS, .position = pos, .index = index};
+    mesh_adjacency adj;
+    sheet_walk w;
+    assert_true(mesh_adjacency_build(&adj, &m));
+    assert_true(sheet_walk_init(&w, VERTS));
+    /* From a corner of the first facet: every unfolded copy, and no other. */
+    int reached = mesh_sheet_walk(&adj, pos, nrm, 0, 100.0, MIN_COS, NULL, &w);
+    int flat = 0;
+    for (int k = 0; k < VERTS; k++)
+        flat += !folded[k];
+    assert_int_equal(reached, flat);
+    for (int i = 0; i < reached; i++)
+        assert_false(folded[w.queue[i]]);
+    /* Within a reach of 1.1 of the origin: the copies of (0,0,0), (1,0,0),
+     * (0,0,1) and (1,0,1) only (the walk goes on only through vertices
+     * within reach). */
+    reached = mesh_sheet_walk(&adj, pos, nrm, 0, 1.5, MIN_COS, NULL, &w);
+    int near = 0;
+    for (int k = 0; k < VERTS; k++)
+        near += pos[3 * k] <= 1.0f && pos[3 * k + 2] <= 1.0f;
+    assert_int_equal(reached, near);
+    /* A copy marked as taken stops the walk, as any vertex does. */
+    uint8_t taken[VERTS];
+    memset(taken, 0xff, sizeof taken);
+    for (int k = 1; k < VERTS; k++)
+        if (pos[3 * k] == 0.0f && pos[3 * k + 2] == 0.0f) {
+            taken[k] = 0;
+            break;
+        }
+    assert_int_equal(mesh_sheet_walk(&adj, pos, nrm, 0, 100.0, MIN_COS, taken, &w), -1);
+    sheet_walk_free(&w);
+    mesh_adjacency_free(&adj);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_sheet_walk_crosses_split_vertices),
         cmocka_unit_test(test_groups_follow_their_rules),
         cmocka_unit_test(test_members_start_from_the_leaders_cut),
         cmocka_unit_test(test_forest_the_same_on_any_thread_count),

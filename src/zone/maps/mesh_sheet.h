@@ -10,7 +10,10 @@
 
 #include "scene/mesh.h"
 
-/* A mesh's vertices' neighbours along its edges. */
+/* A mesh's vertices' neighbours: along its edges, and its other vertices
+ * at the same position (a file splits a vertex where its normal or texture
+ * coordinates change: every corner of a faceted model is such a copy, so
+ * without them a faceted model's sheets were single triangles). */
 typedef struct mesh_adjacency {
     int32_t *first;     /* vertex_count + 1 */
     int32_t *list;
