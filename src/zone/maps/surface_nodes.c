@@ -46,7 +46,8 @@ static int is_diffuse_thing(const rscene *rs, const rs_part *p)
 
 /* Node coordinates along one plane axis: uniform over [a, b] (at least h
  * wide, at most max_side steps), then growing outward to `reach`. */
-static double *plane_axis(double a, double b, double h, int max_side, double reach, int *count)
+static double *plane_axis(double a, double b, double h, int max_side, double reach, int *count,
+                          int *core, int *cells)
 {
     if (b - a < h) {
         double c = 0.5 * (a + b);
@@ -77,6 +78,8 @@ static double *plane_axis(double a, double b, double h, int max_side, double rea
         x[outer + k + m] = hi;
     }
     *count = n;
+    *core = outer;
+    *cells = k;
     return x;
 }
 
@@ -106,8 +109,8 @@ static int build_plane(node_plane *pl, const rs_part *p, double h, int max_side,
         s0 = fmin(s0, s), s1 = fmax(s1, s), t0 = fmin(t0, t), t1 = fmax(t1, t);
     }
     double reach = OUTER_REACH * v3_length(v3_sub(hi, lo));
-    pl->su = plane_axis(s0, s1, h, max_side, reach, &pl->nu);
-    pl->sv = plane_axis(t0, t1, h, max_side, reach, &pl->nv);
+    pl->su = plane_axis(s0, s1, h, max_side, reach, &pl->nu, &pl->core_u, &pl->cells_u);
+    pl->sv = plane_axis(t0, t1, h, max_side, reach, &pl->nv, &pl->core_v, &pl->cells_v);
     return pl->su && pl->sv;
 }
 
@@ -176,14 +179,14 @@ static void set_node(surface_nodes *sn, int32_t k, vec3 x, vec3 n, int prim)
     sn->live[k] = 1;
 }
 
-int32_t surface_tri_node(const surface_nodes *sn, const rscene *rs, int prim, int side, int i,
-                         int j)
+/* surface_tri_node with the primitive's mesh given (NULL for a part). */
+static int32_t tri_node_in(const surface_nodes *sn, const rscene *rs, const rs_mesh *mm, int prim,
+                           int side, int i, int j)
 {
     const node_prim *np = &sn->prim[prim];
     int n = np->n;
     int corner = (i == 0 && j == 0) ? 0 : (i == n && j == 0) ? 1 : (i == 0 && j == n) ? 2 : -1;
     if (np->shared && corner >= 0) {
-        const rs_mesh *mm = rs_mesh_of(rs, prim);
         int k = (int)(mm - rs->meshes);
         return sn->vertex_first[k] + side * mm->m->vertex_count +
                (int32_t)rs_mesh_tri(mm, prim)[corner];
@@ -192,6 +195,13 @@ int32_t surface_tri_node(const surface_nodes *sn, const rscene *rs, int prim, in
     if (np->shared)
         local -= 1 + (local > n);
     return np->first + side * np->count + local;
+}
+
+int32_t surface_tri_node(const surface_nodes *sn, const rscene *rs, int prim, int side, int i,
+                         int j)
+{
+    const rs_mesh *mm = sn->prim[prim].shared ? rs_mesh_of(rs, prim) : NULL;
+    return tri_node_in(sn, rs, mm, prim, side, i, j);
 }
 
 int surface_nodes_build(surface_nodes *sn, const rscene *rs, const zt_scene *scene, double h,
@@ -368,8 +378,13 @@ void surface_nodes_free(surface_nodes *sn)
     memset(sn, 0, sizeof *sn);
 }
 
-/* Index of the cell [x[i], x[i+1]] holding s (clamped) and the fraction. */
-static int axis_cell(const double *x, int n, double s, double *f)
+/* Index of the cell [x[i], x[i+1]] holding s (clamped) and the fraction:
+ * the last i with x[i] <= s.  Inside the uniform core (cells from `core`
+ * on) the cell is guessed from its width and set right by a step or two
+ * (the rounding of the guess); outside it, a binary search.  Camera
+ * samples read the core nearly always, and the search's seven dependent
+ * steps were most of a plane's read. */
+static int axis_cell(const double *x, int n, int core, int cells, double s, double *f)
 {
     if (s <= x[0]) {
         *f = 0;
@@ -379,13 +394,26 @@ static int axis_cell(const double *x, int n, double s, double *f)
         *f = 1;
         return n - 2;
     }
-    int lo = 0, hi = n - 1;
-    while (hi - lo > 1) {
-        int mid = (lo + hi) / 2;
-        if (x[mid] <= s)
-            lo = mid;
-        else
-            hi = mid;
+    int lo;
+    double a = x[core], b = x[core + cells];
+    if (s >= a && s < b) {
+        lo = core + (int)((s - a) / (b - a) * cells);
+        if (lo > core + cells - 1)
+            lo = core + cells - 1;
+        while (x[lo] > s)
+            lo--;
+        while (x[lo + 1] <= s)
+            lo++;
+    } else {
+        lo = 0;
+        int hi = n - 1;
+        while (hi - lo > 1) {
+            int mid = (lo + hi) / 2;
+            if (x[mid] <= s)
+                lo = mid;
+            else
+                hi = mid;
+        }
     }
     *f = (s - x[lo]) / (x[lo + 1] - x[lo]);
     return lo;
@@ -428,8 +456,22 @@ int surface_nodes_weights(const surface_nodes *sn, const rscene *rs, int prim, i
         return 0;
     switch (np->kind) {
     case NODE_TRIANGLE: {
-        rs_part tmp;
-        const rs_part *p = rs_prim(rs, prim, &tmp);
+        /* Only the corner and the edges are needed: a mesh triangle's are
+         * read from its vertices (as rs_mesh_part makes them), not through
+         * the whole part view, whose frame and normal cost more than the
+         * rest of this read. */
+        const rs_mesh *mm = NULL;
+        rs_part corner;
+        const rs_part *p = &corner;
+        if (prim < rs->part_count) {
+            p = &rs->parts[prim];
+        } else {
+            mm = rs_mesh_of(rs, prim);
+            const uint32_t *tv = rs_mesh_tri(mm, prim);
+            corner.p0 = rs_mesh_vertex(mm, tv[0]);
+            corner.e1 = f3_sub(rs_mesh_vertex(mm, tv[1]), corner.p0);
+            corner.e2 = f3_sub(rs_mesh_vertex(mm, tv[2]), corner.p0);
+        }
         float b1, b2;
         rs_triangle_barycentric(p, v3_to_f3(x), &b1, &b2);
         int n = np->n;
@@ -448,14 +490,14 @@ int surface_nodes_weights(const surface_nodes *sn, const rscene *rs, int prim, i
             i = n - 1 - j;
         double fu = u - i, fv = v - j;
         if (fu + fv <= 1.0) {
-            node[0] = surface_tri_node(sn, rs, prim, side, i, j);
-            node[1] = surface_tri_node(sn, rs, prim, side, i + 1, j);
-            node[2] = surface_tri_node(sn, rs, prim, side, i, j + 1);
+            node[0] = tri_node_in(sn, rs, mm, prim, side, i, j);
+            node[1] = tri_node_in(sn, rs, mm, prim, side, i + 1, j);
+            node[2] = tri_node_in(sn, rs, mm, prim, side, i, j + 1);
             w[0] = (float)(1.0 - fu - fv), w[1] = (float)fu, w[2] = (float)fv;
         } else {
-            node[0] = surface_tri_node(sn, rs, prim, side, i + 1, j + 1);
-            node[1] = surface_tri_node(sn, rs, prim, side, i, j + 1);
-            node[2] = surface_tri_node(sn, rs, prim, side, i + 1, j);
+            node[0] = tri_node_in(sn, rs, mm, prim, side, i + 1, j + 1);
+            node[1] = tri_node_in(sn, rs, mm, prim, side, i, j + 1);
+            node[2] = tri_node_in(sn, rs, mm, prim, side, i + 1, j);
             w[0] = (float)(fu + fv - 1.0), w[1] = (float)(1.0 - fu), w[2] = (float)(1.0 - fv);
         }
         return keep_live(sn, node, w, 3);
@@ -464,8 +506,8 @@ int surface_nodes_weights(const surface_nodes *sn, const rscene *rs, int prim, i
         const node_plane *pl = &sn->planes[np->geom];
         vec3 d = v3_sub(x, pl->origin);
         double fu, fv;
-        int i = axis_cell(pl->su, pl->nu, v3_dot(d, pl->u), &fu);
-        int j = axis_cell(pl->sv, pl->nv, v3_dot(d, pl->v), &fv);
+        int i = axis_cell(pl->su, pl->nu, pl->core_u, pl->cells_u, v3_dot(d, pl->u), &fu);
+        int j = axis_cell(pl->sv, pl->nv, pl->core_v, pl->cells_v, v3_dot(d, pl->v), &fv);
         int32_t base = np->first + side * np->count;
         node[0] = base + j * pl->nu + i;
         node[1] = node[0] + 1;

@@ -31,6 +31,8 @@ typedef struct node_plane {
     vec3 origin, u, v, n;
     int nu, nv;
     double *su, *sv;    /* ascending node coordinates */
+    /* Where each axis's uniform core begins in su / sv, and its cells. */
+    int core_u, cells_u, core_v, cells_v;
 } node_plane;
 
 /* A sphere's grid: row i at polar angle (i + 0.5) pi / nt from +z' (the
