@@ -30,6 +30,14 @@ void accel_free(struct accel *a);
  * background rule; h.part = -1 when nothing is hit. */
 hit accel_intersect(const rscene *rs, vec3f o, vec3f d);
 
+/* The nearest triangle or sphere of either layer on the ray within
+ * (0, tmax), back faces included whether or not the primitive is culled,
+ * planes and holes not looked at: the first surface a direction meets,
+ * as node life's probes ask it (zone/phase_one/node_life.c).  Returns 0
+ * when the backend has no such query (then *h is untouched), else 1 with
+ * h->part = -1 when nothing is hit. */
+int accel_nearest_all_sides(const rscene *rs, vec3f o, vec3f d, float tmax, hit *h);
+
 /* Whether the point at distance dist along (o, d) is hidden: by a
  * foreground primitive before dist; when the target is a background
  * primitive also by any foreground primitive beyond it or a background one

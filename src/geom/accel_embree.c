@@ -37,6 +37,25 @@ typedef struct embree_accel {
     geom_map *map[2];
 } embree_accel;
 
+/* A query's context: Embree's (first, as Embree's callbacks are handed
+ * it), and whether culled primitives show their backs too (node life's
+ * probes: accel_nearest_all_sides). */
+typedef struct query_context {
+    struct RTCIntersectContext ctx;
+    int all_sides;
+} query_context;
+
+static void query_context_init(query_context *q, int all_sides)
+{
+    rtcInitIntersectContext(&q->ctx);
+    q->all_sides = all_sides;
+}
+
+static inline int all_sides(const struct RTCIntersectContext *ctx)
+{
+    return ((const query_context *)ctx)->all_sides;
+}
+
 static inline int prim_of(const geom_map *m, unsigned prim)
 {
     return m->part_of_prim ? m->part_of_prim[prim] : m->prim_base + (int)prim;
@@ -45,6 +64,8 @@ static inline int prim_of(const geom_map *m, unsigned prim)
 /* Rejects hits on the back of culled primitives. */
 static void cull_filter(const struct RTCFilterFunctionNArguments *args)
 {
+    if (all_sides(args->context))
+        return;
     const geom_map *m = args->geometryUserPtr;
     unsigned n = args->N;
     const float *ray = (const float *)args->ray;
@@ -98,6 +119,12 @@ enum { RN_OX, RN_OY, RN_OZ, RN_TNEAR, RN_DX, RN_DY, RN_DZ, RN_TIME, RN_TFAR };
 static void sphere_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     const rs_part *p = sphere_part(args->geometryUserPtr, args->primID);
+    rs_part open;
+    if (p->culled && all_sides(args->context)) {
+        open = *p;
+        open.culled = 0;
+        p = &open;
+    }
     unsigned n = args->N;
     float *ray = (float *)args->rayhit;
     /* RTCRayHitN: the ray's 12 fields, then the hit's Ng (3), u, v,
@@ -121,6 +148,12 @@ static void sphere_intersect(const struct RTCIntersectFunctionNArguments *args)
 static void sphere_occluded(const struct RTCOccludedFunctionNArguments *args)
 {
     const rs_part *p = sphere_part(args->geometryUserPtr, args->primID);
+    rs_part open;
+    if (p->culled && all_sides(args->context)) {
+        open = *p;
+        open.culled = 0;
+        p = &open;
+    }
     unsigned n = args->N;
     float *ray = (float *)args->ray;
     for (unsigned i = 0; i < n; i++) {
@@ -135,13 +168,13 @@ static void sphere_occluded(const struct RTCOccludedFunctionNArguments *args)
     }
 }
 
-static void embree_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
+static void nearest_sides(const accel *a, int layer, vec3f o, vec3f d, hit *h, int sides)
 {
     const embree_accel *e = (const embree_accel *)a;
     if (e->empty[layer])
         return;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    query_context q;
+    query_context_init(&q, sides);
     struct RTCRayHit rh;
     rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
     rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
@@ -153,11 +186,21 @@ static void embree_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
     rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(e->scene[layer], &ctx, &rh);
+    rtcIntersect1(e->scene[layer], &q.ctx, &rh);
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
         h->t = rh.ray.tfar;
         h->part = prim_of(&e->map[layer][rh.hit.geomID], rh.hit.primID);
     }
+}
+
+static void embree_nearest(const accel *a, int layer, vec3f o, vec3f d, hit *h)
+{
+    nearest_sides(a, layer, o, d, h, 0);
+}
+
+static void embree_nearest_all_sides(const accel *a, int layer, vec3f o, vec3f d, hit *h)
+{
+    nearest_sides(a, layer, o, d, h, 1);
 }
 
 /* Embree includes tfar; the contract excludes it: one float below. */
@@ -176,8 +219,8 @@ static int embree_any(const accel *a, int layer, vec3f o, vec3f d, float tmax)
     const embree_accel *e = (const embree_accel *)a;
     if (e->empty[layer])
         return 0;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    query_context q;
+    query_context_init(&q, 0);
     struct RTCRay r;
     r.org_x = o.x; r.org_y = o.y; r.org_z = o.z;
     r.dir_x = d.x; r.dir_y = d.y; r.dir_z = d.z;
@@ -187,7 +230,7 @@ static int embree_any(const accel *a, int layer, vec3f o, vec3f d, float tmax)
     r.mask = 0xffffffffu;
     r.id = 0;
     r.flags = 0;
-    rtcOccluded1(e->scene[layer], &ctx, &r);
+    rtcOccluded1(e->scene[layer], &q.ctx, &r);
     return r.tfar < 0.0f;
 }
 
@@ -237,8 +280,8 @@ static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, con
     const embree_accel *e = (const embree_accel *)a;
     if (e->empty[layer])
         return;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    query_context q;
+    query_context_init(&q, 0);
     int w = a->packet;
     _Alignas(64) packet ray;
     for (int base = 0; base < n; base += w) {
@@ -253,11 +296,11 @@ static void embree_any_n(const accel *a, int layer, vec3f o, const vec3f *d, con
         if (!packet_fill(&ray, valid, w, m, &o, 0, d + base, far, on))
             continue;
         if (w == 16)
-            rtcOccluded16(valid, e->scene[layer], &ctx, (struct RTCRay16 *)&ray);
+            rtcOccluded16(valid, e->scene[layer], &q.ctx, (struct RTCRay16 *)&ray);
         else if (w == 8)
-            rtcOccluded8(valid, e->scene[layer], &ctx, (struct RTCRay8 *)&ray);
+            rtcOccluded8(valid, e->scene[layer], &q.ctx, (struct RTCRay8 *)&ray);
         else
-            rtcOccluded4(valid, e->scene[layer], &ctx, (struct RTCRay4 *)&ray);
+            rtcOccluded4(valid, e->scene[layer], &q.ctx, (struct RTCRay4 *)&ray);
         for (int j = 0; j < m; j++)
             if (valid[j] && RAY_N(ray.f, w, RN_TFAR, j) < 0.0f)
                 hidden[base + j] = 1;
@@ -272,8 +315,8 @@ static void embree_nearest_n(const accel *a, int layer, const vec3f *o, int o_st
     const embree_accel *e = (const embree_accel *)a;
     if (e->empty[layer])
         return;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    query_context q;
+    query_context_init(&q, 0);
     int w = a->packet;
     _Alignas(64) packet rh;
     unsigned *bits = rh.u;
@@ -292,11 +335,11 @@ static void embree_nearest_n(const accel *a, int layer, const vec3f *o, int o_st
         if (!any)
             continue;
         if (w == 16)
-            rtcIntersect16(valid, e->scene[layer], &ctx, (struct RTCRayHit16 *)&rh);
+            rtcIntersect16(valid, e->scene[layer], &q.ctx, (struct RTCRayHit16 *)&rh);
         else if (w == 8)
-            rtcIntersect8(valid, e->scene[layer], &ctx, (struct RTCRayHit8 *)&rh);
+            rtcIntersect8(valid, e->scene[layer], &q.ctx, (struct RTCRayHit8 *)&rh);
         else
-            rtcIntersect4(valid, e->scene[layer], &ctx, (struct RTCRayHit4 *)&rh);
+            rtcIntersect4(valid, e->scene[layer], &q.ctx, (struct RTCRayHit4 *)&rh);
         for (int j = 0; j < m; j++) {
             unsigned geom = bits[18 * w + j];
             if (!valid[j] || geom == RTC_INVALID_GEOMETRY_ID)
@@ -429,6 +472,7 @@ zt_status accel_build_embree(rscene *rs, zt_error *err)
     if (!e)
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
     e->base.nearest = embree_nearest;
+    e->base.nearest_all_sides = embree_nearest_all_sides;
     e->base.any = embree_any;
     e->base.destroy = embree_destroy;
     e->device = rtcNewDevice(NULL);

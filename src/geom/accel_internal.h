@@ -21,6 +21,10 @@ typedef struct accel {
      * whose want[i] is set. */
     void (*nearest_n)(const struct accel *a, int layer, const vec3f *o, int o_step,
                       const vec3f *d, int n, const unsigned char *want, hit *h);
+    /* nearest with culling off: back faces of culled primitives are hit
+     * too (NULL where the backend has no such query: the BVH's, whose
+     * culling is part of its hot triangle test, and the brute force). */
+    void (*nearest_all_sides)(const struct accel *a, int layer, vec3f o, vec3f d, hit *h);
     void (*destroy)(struct accel *a);
     /* Whether the layer has any primitives (set by accel_build): most
      * scenes have only planes in one of them, and the call is skipped. */

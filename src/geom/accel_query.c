@@ -281,6 +281,19 @@ void accel_intersect_rays(const rscene *rs, const vec3f *o, const vec3f *d, int 
     intersect_n(rs, o, 1, d, n, h);
 }
 
+int accel_nearest_all_sides(const rscene *rs, vec3f o, vec3f d, float tmax, hit *h)
+{
+    const accel *a = rs->accel;
+    if (!a->nearest_all_sides)
+        return 0;
+    hit best = {tmax, -1};
+    for (int layer = 0; layer < 2; layer++)
+        if (a->has_prims[layer])
+            a->nearest_all_sides(a, layer, o, d, &best);
+    *h = best.part >= 0 ? best : (hit){FLT_MAX, -1};
+    return 1;
+}
+
 void accel_free(struct accel *a)
 {
     if (a)
