@@ -227,20 +227,19 @@ int node_life_first_hit(const occluder_index *occ, const zt_scene *scene, const 
                         vec3 o, vec3 d, int *back)
 {
     /* Where the renderer's structure can take culling off (Embree), the
-     * primitives go to it: the index's walk in double was up to 40% of
-     * Phase One on a large model (the engine room at quality 0). */
-    double best = INFINITY;
-    int found = planes_first_hit(scene, rs, o, d, &best, -1, back);
+     * primitives go to it, the planes as first_hit takes them: the index's
+     * walk in double was up to 40% of Phase One on a large model (the
+     * engine room at quality 0). */
     hit h;
-    float reach = best < FLT_MAX ? (float)best : FLT_MAX;
-    if (accel_nearest_all_sides(rs, v3_to_f3(o), v3_to_f3(d), reach, &h)) {
-        if (h.part >= 0) {
+    vec3f df = v3_to_f3(d);
+    if (accel_nearest_all_sides(rs, v3_to_f3(o), df, FLT_MAX, &h)) {
+        double best = h.part >= 0 ? (double)h.t : INFINITY;
+        int found = planes_first_hit(scene, rs, o, d, &best, h.part, back);
+        if (found >= 0 && found == h.part) {
             rs_part tmp;
             const rs_part *p = rs_prim(rs, h.part, &tmp);
-            vec3f df = v3_to_f3(d);
             vec3f x = shape_hit_point(p, v3_to_f3(o), df, h.t);
             *back = f3_dot(shape_normal(p, x), df) > 0.0f;
-            found = h.part;
         }
         return found;
     }
