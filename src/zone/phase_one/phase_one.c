@@ -330,11 +330,12 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 #define GATHERED_MESH_CUT_DIV 4
 /* For the same reason a mesh node's gather is kept at the error a cut of
  * that quarter limit allows: a cut's error goes about as one over the
- * square root of its clusters, so twice the level's eps.  Whole jobs: the
+ * square root of its clusters, so the level's eps times the square root
+ * of the limit's divisor: twice it.  Whole jobs: the
  * engine room 256 x 256 A/B 0.967, 0.930% -> 0.928% per pixel; Wuson
  * alone A/B 0.875, 0.273% -> 0.279%; house_day at quality 0 (single runs)
  * Phase One 11.75 -> 11.45 s, 2.200% both. */
-#define GATHERED_MESH_EPS_MUL 2.0
+#define GATHERED_MESH_EPS_MUL sqrt((double)GATHERED_MESH_CUT_DIV)
 
 /* Where a triangle node's light is computed: moved this share of the way
  * toward its triangle's centroid.  A node on a triangle's edge or corner
@@ -397,11 +398,12 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
     transfer_ctx tk = *tc;
     tk.eps = tc->eps * sqrt(sn->growth[k]);
     bounce_limit lim = {.eps = tk.eps, .lower = light_below(f, level, k), .floor = tc->floor};
-    if (prim >= r->rs.part_count)
+    int on_mesh = prim >= r->rs.part_count;
+    if (on_mesh)
         lim.eps *= GATHERED_MESH_EPS_MUL;
     *gathered = bounce_gather(&t, f->bounce_dirs, f->q.gather, x, n, level, &lim, &e);
     if (!*gathered) {
-        if (prim >= r->rs.part_count)
+        if (on_mesh)
             tk.max_cut = tc->max_cut / GATHERED_MESH_CUT_DIV;
         transfer_stats ts = {0};
         e = from ? transfer_irradiance_near(&tk, x, n, from, tk.max_cut / GROUP_MORE, &ts)
