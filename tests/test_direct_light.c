@@ -284,7 +284,7 @@ static void test_sky_splits_share_the_directions(void **state)
         zt_scene *scene;
         zt_renderer *r = comb_renderer(&scene, light);
         assert_true(r->forest->sky);
-        assert_int_equal(r->forest->sky_dir_count > 0, k == 1);
+        assert_int_equal(r->forest->sky_set.count > 0, k == 1);
         double worst = 0, spread_under = 0, spread_beside = 0;
         for (int j = 1; j <= 3; j++) {
             double s;

@@ -31,6 +31,14 @@ static inline void v3_frame(vec3 n, vec3 *t, vec3 *b)
     *t = v3_normalize(v3_cross(a, n));
     *b = v3_cross(n, *t);
 }
+/* The tangents t, b of a frame turned by `angle` about its normal. */
+static inline void v3_turn_frame(vec3 *t, vec3 *b, double angle)
+{
+    double c = cos(angle), s = sin(angle);
+    vec3 tt = v3_add(v3_scale(*t, c), v3_scale(*b, s));
+    *b = v3_sub(v3_scale(*b, c), v3_scale(*t, s));
+    *t = tt;
+}
 /* min and max without fmin/fmax's NaN rules, which keep the compiler from
  * inlining them (hot loops over boxes). */
 static inline double dmin(double a, double b) { return a < b ? a : b; }

@@ -99,6 +99,53 @@ typedef struct zone_quality {
  * their rays as packets). */
 #define ZONE_SKY_RUN 64
 
+/* A mesh's nodes are read only through averages of many: the camera's
+ * samples on meshes gather their light from them, and as senders they
+ * send by clusters.  So a mesh node's own estimates take this share of a
+ * node's effort: its cut's cluster limit, its gather's and its sky's
+ * directions (phase_one.c says what each is worth). */
+#define ZONE_MESH_NODE_DIV 4
+/* The shifted sets of an environment map's directions that mesh nodes
+ * take between them (light/sky_gather.h). */
+#define ZONE_NODE_SKY_SETS 16
+
+/* The key that sets mesh node k's directions apart from its neighbours'
+ * at a level (zone_trace.node_draw; never 0): a 32-bit mix (Wellons'
+ * lowbias32) of the two, so that one node's directions differ from level
+ * to level too. */
+static inline uint32_t zone_node_draw_key(int32_t k, int level)
+{
+    uint32_t x = (uint32_t)k * 0x9e3779b9u + (uint32_t)level * 0x85ebca6bu;
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x ? x : 1;
+}
+/* What the key sets: the angle by which the node turns a set about its
+ * normal (a shift of the set's azimuth), and which of an environment
+ * map's shifted sets it takes (the key's other bits). */
+static inline double zone_node_turn(uint32_t key)
+{
+    return (key & 0xffffff) * (2 * 3.14159265358979323846 / 16777216.0);
+}
+static inline int zone_node_set(uint32_t key)
+{
+    return (int)(key >> 28) & (ZONE_NODE_SKY_SETS - 1);
+}
+
+/* Directions drawn from an environment map, each with its radiance /
+ * (density x count), also as six rows (x, y, z, then the weight's r, g,
+ * b) of soa_stride floats each, padded with zeros to a multiple of
+ * ZONE_SKY_RUN: a point's cosines with all of them go four at a time. */
+typedef struct zone_sky_set {
+    vec3f *dirs, *weight;
+    int count;
+    float *soa;
+    size_t soa_stride;
+} zone_sky_set;
+
 typedef struct zone_forest {
     zone *zones;
     int zone_count, zone_capacity;
@@ -141,19 +188,20 @@ typedef struct zone_forest {
     int specular;       /* some object has a metallic, reflecting or
                            refractive lobe */
     int sky;            /* the sky is not black: E_0 gathers it */
-    /* An environment map's gather: directions drawn from it by importance
-     * (world frame) and each one's radiance / (density x count); and the
-     * map's irradiance on an open surface of each normal (a table over the
+    /* An environment map's gather (light/sky_gather.h): directions drawn
+     * from it by importance, every one for a camera sample and most nodes,
+     * and ZONE_NODE_SKY_SETS shifted sets of a ZONE_MESH_NODE_DIV-th as
+     * many for mesh nodes, each of which takes one; and the map's
+     * irradiance on an open surface of each normal (a table over the
      * sphere of normals, laid out as the map's texels), which the gather
-     * scales by the share of its light that arrives. */
-    vec3f *sky_dirs, *sky_weight;
-    int sky_dir_count;
-    /* The same as six rows (x, y, z, then the weight's r, g, b) of
-     * sky_soa_stride floats each, padded with zeros to a multiple of
-     * ZONE_SKY_RUN: a point's cosines with all of them go four at a time. */
-    float *sky_soa;
-    size_t sky_soa_stride;
+     * scales by the share of its light that arrives.  Empty without one. */
+    zone_sky_set sky_set;
+    zone_sky_set node_sky[ZONE_NODE_SKY_SETS];
     float *sky_open;    /* ZONE_SKY_TABLE_W x ZONE_SKY_TABLE_H x rgb */
+    /* A sky of one colour: a mesh node's cosine-weighted set about its
+     * normal (a ZONE_MESH_NODE_DIV-th of q.gather), turned by its key. */
+    vec3 *node_dirs;
+    int node_dir_count;
     sky_portals portals; /* the panes, where the sky's gather aims (under a
                             sky) */
     int *glint_spheres; /* spheres that reflect lights as images (glint.h) */
@@ -225,6 +273,10 @@ typedef struct zone_trace {
     /* Exact direct light at a camera sample that shares the fallback's
      * rays with its neighbours (direct_irradiance_split), 0: alone. */
     int light_split;
+    /* Set by Phase One at a mesh node (ZONE_MESH_NODE_DIV): the key that
+     * sets its sky's and its gather's directions apart from its
+     * neighbours' (zone_node_draw_key); 0: every direction, as is. */
+    uint32_t node_draw;
     zone_gather_slot gather; /* the camera sample's (zone_mesh_irradiance
                                 and its rough lobes' directions) */
     /* Gathers at the pixels' centres that a camera sample's may take

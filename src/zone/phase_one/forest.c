@@ -14,6 +14,7 @@
 #include "util/sampler.h"
 #include "util/vec3_convert.h"
 #include "geom/ray_offset.h"
+#include "zone/light/sky_gather.h"
 #include "zone/phase_one/glint.h"
 #include "zone/phase_one/specular_targets.h"
 #include "zone/transfer/bounce_gather.h"
@@ -202,77 +203,6 @@ vec3 *zone_gather_directions(int n)
     return d;
 }
 
-/* n directions drawn from the map (a Hammersley set through its own
- * sampling, so that a small bright patch gets its share of them), each with
- * its radiance / (density x n); returns how many carry light. */
-static int map_directions(const rscene *rs, int n, vec3f *dirs, vec3f *weight)
-{
-    int k = 0;
-    for (int i = 0; i < n; i++) {
-        uint32_t b = sampler_reverse_bits((uint32_t)i);
-        float u[2] = {(float)((i + 0.5) / n), (float)(b * (1.0 / 4294967296.0))};
-        vec3f w, l;
-        float pdf = distant_map_sample(&rs->distant, u, &w, &l);
-        if (pdf <= 0.0f)
-            continue;
-        dirs[k] = w;
-        weight[k++] = f3_scale(l, 1.0f / (pdf * (float)n));
-    }
-    return k;
-}
-
-/* The environment map's gather directions (f->q.gather of them) and its
- * open-surface irradiance table (zone.h). */
-static int sky_map_directions(zone_forest *f, const rscene *rs)
-{
-    int n = f->q.gather, m = ZONE_SKY_TABLE_SAMPLES;
-    f->sky_dirs = malloc((size_t)n * sizeof *f->sky_dirs);
-    f->sky_weight = malloc((size_t)n * sizeof *f->sky_weight);
-    f->sky_open = malloc((size_t)ZONE_SKY_TABLE_W * ZONE_SKY_TABLE_H * 3 * sizeof(float));
-    vec3f *dirs = malloc((size_t)m * sizeof *dirs), *weight = malloc((size_t)m * sizeof *weight);
-    if (!f->sky_dirs || !f->sky_weight || !f->sky_open || !dirs || !weight) {
-        free(dirs);
-        free(weight);
-        return 0;
-    }
-    f->sky_dir_count = map_directions(rs, n, f->sky_dirs, f->sky_weight);
-    size_t stride = ((size_t)f->sky_dir_count + ZONE_SKY_RUN - 1) / ZONE_SKY_RUN * ZONE_SKY_RUN;
-    f->sky_soa_stride = stride;
-    f->sky_soa = calloc(6 * (stride ? stride : 1), sizeof *f->sky_soa);
-    if (!f->sky_soa) {
-        free(dirs);
-        free(weight);
-        return 0;
-    }
-    for (int k = 0; k < f->sky_dir_count; k++) {
-        const float v[6] = {f->sky_dirs[k].x,   f->sky_dirs[k].y,   f->sky_dirs[k].z,
-                            f->sky_weight[k].x, f->sky_weight[k].y, f->sky_weight[k].z};
-        for (int row = 0; row < 6; row++)
-            f->sky_soa[(size_t)row * stride + (size_t)k] = v[row];
-    }
-    int count = map_directions(rs, m, dirs, weight);
-    for (int j = 0; j < ZONE_SKY_TABLE_H; j++)
-        for (int i = 0; i < ZONE_SKY_TABLE_W; i++) {
-            vec3f nrm = env_map_direction((i + 0.5f) / ZONE_SKY_TABLE_W,
-                                          (j + 0.5f) / ZONE_SKY_TABLE_H);
-            double e[3] = {0, 0, 0};
-            for (int k = 0; k < count; k++) {
-                float c = f3_dot(nrm, dirs[k]);
-                if (c > 0.0f) {
-                    e[0] += weight[k].x * c;
-                    e[1] += weight[k].y * c;
-                    e[2] += weight[k].z * c;
-                }
-            }
-            float *t = f->sky_open + 3 * ((size_t)j * ZONE_SKY_TABLE_W + i);
-            for (int ch = 0; ch < 3; ch++)
-                t[ch] = (float)e[ch];
-        }
-    free(dirs);
-    free(weight);
-    return 1;
-}
-
 zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
 {
     const rscene *rs = &r->rs;
@@ -346,8 +276,8 @@ zt_status zone_forest_frame(zone_forest *f, const zt_renderer *r, zt_error *err)
             f->specular = 1;
     }
     f->sky = !f3_is_black(rs->sky) || rs->distant.map;
-    if (rs->distant.map && !sky_map_directions(f, rs))
-        return zt_fail(err, ZT_ERR_MEMORY, "out of memory");
+    if (!zone_sky_build(f, rs))
+        return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the sky's directions");
     if (f->sky && !sky_portals_build(&f->portals, rs))
         return zt_fail(err, ZT_ERR_MEMORY, "out of memory for the sky's portals");
     if (rs->distant.sun) {
@@ -376,10 +306,7 @@ void zone_forest_free(zone_forest *f)
     free(f->spec_targets);
     free(f->dirs);
     free(f->bounce_dirs);
-    free(f->sky_dirs);
-    free(f->sky_weight);
-    free(f->sky_soa);
-    free(f->sky_open);
+    zone_sky_free(f);
     sky_portals_free(&f->portals);
     sender_tree_free(&f->light_tree);
     memset(f, 0, sizeof *f);

@@ -10,7 +10,6 @@
  *
  * Pixel level L reads E_{L-1} (level 1 is exact per pixel), so depth D
  * needs E_0 .. E_{D-1}. */
-#include <float.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -18,16 +17,10 @@
 #include <string.h>
 
 #include "geom/accel.h"
-#include "geom/transmittance.h"
 #include "render/prim.h"
-#include "light/distant.h"
-#include "light/env_map.h"
-#include "geom/ray_offset.h"
 #include "render/share.h"
 #include "util/error.h"
-#include "util/simd4.h"
 #include "util/vec3_convert.h"
-#include "zone/light/sky_portals.h"
 #include "zone/maps/mesh_rounds.h"
 #include "zone/maps/node_groups.h"
 #include "zone/maps/node_twins.h"
@@ -39,254 +32,6 @@
 #include "zone/transfer/sender_tree.h"
 #include "zone/transfer/transfer.h"
 #include "zone/zone.h"
-
-/* The map's irradiance on an open surface of unit normal n: the table
- * read bilinearly between its normals (around in azimuth, clamped at the
- * poles). */
-static vec3 sky_open_irradiance(const zone_forest *f, vec3f n)
-{
-    float u, v;
-    env_map_uv(n, &u, &v);
-    float fx = u * ZONE_SKY_TABLE_W - 0.5f, fy = v * ZONE_SKY_TABLE_H - 0.5f;
-    int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
-    float ax = fx - (float)x0, ay = fy - (float)y0;
-    vec3 e = v3(0, 0, 0);
-    for (int dy = 0; dy < 2; dy++)
-        for (int dx = 0; dx < 2; dx++) {
-            int xi = ((x0 + dx) % ZONE_SKY_TABLE_W + ZONE_SKY_TABLE_W) % ZONE_SKY_TABLE_W;
-            int yi = y0 + dy < 0 ? 0 : (y0 + dy >= ZONE_SKY_TABLE_H ? ZONE_SKY_TABLE_H - 1 : y0 + dy);
-            double w = (dx ? ax : 1 - ax) * (dy ? ay : 1 - ay);
-            const float *t = f->sky_open + 3 * ((size_t)yi * ZONE_SKY_TABLE_W + xi);
-            e = v3_add(e, v3_scale(v3(t[0], t[1], t[2]), w));
-        }
-    return e;
-}
-
-/* The directions of `count` that a point takes: all of them, or for a
- * split point (direct.h) those whose index modulo `stride` is within
- * `width` of its `first`, so that the block's points take them all
- * between them, each direction once, for one point's rays (points
- * `stride` apart share when the block outnumbers them).  Which directions
- * a point takes follows its place in the block, as its pieces of a light
- * do; a point that stands for the 2 x 2 block of points a level finer
- * (DIRECT_SPLIT_BLOCK) takes the four's. */
-typedef struct sky_part {
-    int first, stride, width;
-} sky_part;
-
-static sky_part sky_share(int split, int count)
-{
-    sky_part p = {0, 1, 1};
-    if (!split)
-        return p;
-    int block = (split & DIRECT_SPLIT_BLOCK) != 0;
-    int levels = DIRECT_SPLIT_SKY_LEVELS(split) + block;
-    int index = DIRECT_SPLIT_INDEX(split) << (2 * block);
-    while (levels-- > 0 && p.stride * 4 <= count)
-        p.stride *= 4;
-    p.first = index % p.stride;
-    p.width = block && p.stride >= 4 ? 4 : 1; /* (a stride of 1 takes all) */
-    return p;
-}
-
-static int sky_takes(const sky_part *p, int k)
-{
-    int r = k % p->stride - p->first;
-    return r >= 0 && r < p->width;
-}
-
-/* Sky rays a point sends to the scene at a time (a run of the environment
- * map's directions). */
-#define SKY_PACKET ZONE_SKY_RUN
-
-/* The share of the gather's count that a point aims at portals. */
-#define SKY_PORTAL_SHARE 2
-
-/* Portal directions waiting for their rays (sky_through_portals). */
-typedef struct portal_rays {
-    vec3f o;
-    int n;
-    vec3f d[SKY_PACKET];
-    double weight[SKY_PACKET]; /* share x cosine */
-    int portal[SKY_PACKET];
-} portal_rays;
-
-/* Casts the waiting rays together and adds to *e the light of those
- * whose first pane is their own portal's. */
-static void portal_rays_flush(zone_trace *t, portal_rays *pr, vec3 *e)
-{
-    const zone_forest *f = t->f;
-    const rscene *rs = &t->r->rs;
-    float far[SKY_PACKET];
-    int pane[SKY_PACKET];
-    vec3f tr[SKY_PACKET];
-    if (!pr->n)
-        return;
-    for (int i = 0; i < pr->n; i++)
-        far[i] = FLT_MAX;
-    t->rays += (uint64_t)pr->n;
-    accel_transmittance_panes_n(rs, pr->o, pr->d, far, pr->n, 1, tr, pane);
-    for (int i = 0; i < pr->n; i++) {
-        if (f3_is_black(tr[i]) || pane[i] < 0 || f->portals.of_prim[pane[i]] != pr->portal[i])
-            continue;
-        vec3f l = f->sky_dir_count ? distant_map_radiance(&rs->distant, pr->d[i]) : rs->sky;
-        *e = v3_add(*e, v3_scale(f3_to_v3(f3_mul(l, tr[i])), pr->weight[i]));
-    }
-    pr->n = 0;
-}
-
-/* The sky's light through the portals that a point aims at (sky_portals.h):
- * over each, the directions whose first pane is one of its own.  A split
- * point takes its share of them, as of the gather's. */
-static vec3 sky_through_portals(zone_trace *t, vec3 n, vec3f o,
-                                const sky_portal_pick *picks, int count)
-{
-    int total = 0;
-    for (int i = 0; i < count; i++)
-        total += picks[i].count;
-    sky_part mine = sky_share(t->light_split, total);
-    vec3 e = v3(0, 0, 0);
-    portal_rays pr;
-    pr.o = o;
-    pr.n = 0;
-    int k = 0;
-    for (int i = 0; i < count; i++) {
-        for (int j = 0; j < picks[i].count; j++, k++) {
-            if (!sky_takes(&mine, k))
-                continue;
-            vec3 d;
-            double share = sky_portal_view_direction(&picks[i].view, j, picks[i].count, &d);
-            double c = v3_dot(n, d);
-            if (!(share > 0) || c <= 0)
-                continue;
-            pr.d[pr.n] = v3_to_f3(d);
-            pr.weight[pr.n] = share * c;
-            pr.portal[pr.n++] = picks[i].portal;
-            if (pr.n == SKY_PACKET)
-                portal_rays_flush(t, &pr, &e);
-        }
-    }
-    portal_rays_flush(t, &pr, &e);
-    return v3_scale(e, (double)mine.stride / mine.width);
-}
-
-/* Whether the gather's rays along d[0..n) (n <= SKY_PACKET) reach the
- * sky, and with what, into tr: 0 where the portals' estimate takes the
- * direction (sky_portals_claim: that light is theirs).  The rays leave o
- * together (packets). */
-static void sky_gather_rays(zone_trace *t, vec3f o, const vec3f *d, int n,
-                            const sky_portal_pick *picks, int count, vec3f *tr)
-{
-    float far[SKY_PACKET];
-    int pane[SKY_PACKET];
-    for (int i = 0; i < n; i++)
-        far[i] = FLT_MAX;
-    t->rays += (uint64_t)n;
-    accel_transmittance_panes_n(&t->r->rs, o, d, far, n, 1, tr, count ? pane : NULL);
-    if (count)
-        for (int i = 0; i < n; i++)
-            if (pane[i] >= 0 &&
-                sky_portals_claim(picks, count, t->f->portals.of_prim[pane[i]], f3_to_v3(d[i])))
-                tr[i] = f3_splat(0.0f);
-}
-
-/* The cosines of the environment map's directions k0 .. k0 + ZONE_SKY_RUN
- * - 1 with n (0 below the horizon, and for the padding past the last)
- * into c, their weights times them added to all's lanes (r, g, b). */
-static void sky_cosines(const zone_forest *f, vec3f n, int k0, float *c, f4 all[3])
-{
-    size_t s = f->sky_soa_stride;
-    const float *x = f->sky_soa + k0, *y = x + s, *z = y + s, *wr = z + s, *wg = wr + s,
-                *wb = wg + s;
-    f4 nx = f4_splat(n.x), ny = f4_splat(n.y), nz = f4_splat(n.z), zero = f4_splat(0.0f);
-    for (int j = 0; j < ZONE_SKY_RUN; j += 4) {
-        f4 dx, dy, dz, r, g, b;
-        memcpy(&dx, x + j, sizeof dx);
-        memcpy(&dy, y + j, sizeof dy);
-        memcpy(&dz, z + j, sizeof dz);
-        memcpy(&r, wr + j, sizeof r);
-        memcpy(&g, wg + j, sizeof g);
-        memcpy(&b, wb + j, sizeof b);
-        f4 cj = f4_max(nx * dx + ny * dy + nz * dz, zero);
-        memcpy(c + j, &cj, sizeof cj);
-        all[0] += r * cj;
-        all[1] += g * cj;
-        all[2] += b * cj;
-    }
-}
-
-vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
-{
-    const zone_forest *f = t->f;
-    const rscene *rs = &t->r->rs;
-    vec3f nf = v3_to_f3(n), o = ray_offset(v3_to_f3(x), nf);
-    sky_portal_pick picks[SKY_PORTAL_PICKS_MAX];
-    int picked = f->portals.count
-                     ? sky_portals_pick(&f->portals, x, n, f->q.gather / SKY_PORTAL_SHARE, picks)
-                     : 0;
-    vec3 portals = picked ? sky_through_portals(t, n, o, picks, picked) : v3(0, 0, 0);
-    if (f->sky_dir_count) {
-        /* An environment map: the open-surface irradiance of the normal,
-         * times the share of it that the importance-drawn directions find
-         * arriving (a ratio estimate: exact where nothing is in the way;
-         * the share's whole is taken over every direction, which costs no
-         * ray). */
-        vec3f seen = f3_splat(0.0f);
-        sky_part share = sky_share(t->light_split, f->sky_dir_count);
-        f4 all[3] = {f4_splat(0.0f), f4_splat(0.0f), f4_splat(0.0f)};
-        vec3f dir[ZONE_SKY_RUN], tr[ZONE_SKY_RUN];
-        float cosine[ZONE_SKY_RUN];
-        int kept[ZONE_SKY_RUN];
-        for (int k0 = 0; k0 < f->sky_dir_count; k0 += ZONE_SKY_RUN) {
-            sky_cosines(f, nf, k0, cosine, all);
-            int rays = 0, end = f->sky_dir_count - k0 < ZONE_SKY_RUN ? f->sky_dir_count - k0
-                                                                      : ZONE_SKY_RUN;
-            for (int j = 0; j < end; j++)
-                if (cosine[j] > 0.0f && sky_takes(&share, k0 + j)) {
-                    dir[rays] = f->sky_dirs[k0 + j];
-                    kept[rays++] = j;
-                }
-            sky_gather_rays(t, o, dir, rays, picks, picked, tr);
-            for (int i = 0; i < rays; i++)
-                if (!f3_is_black(tr[i]))
-                    seen = f3_madd(seen, f3_mul(f->sky_weight[k0 + kept[i]], tr[i]),
-                                   cosine[kept[i]]);
-        }
-        vec3f sum = f3(f4_hsum(all[0]), f4_hsum(all[1]), f4_hsum(all[2]));
-        /* A split point's share of the directions stands for all of them:
-         * the block's points together see what one point's would. */
-        seen = f3_scale(seen, (float)share.stride / (float)share.width);
-        vec3 open = sky_open_irradiance(f, nf);
-        return v3_add(portals, v3(sum.x > 0.0f ? open.x * seen.x / sum.x : open.x,
-                                  sum.y > 0.0f ? open.y * seen.y / sum.y : open.y,
-                                  sum.z > 0.0f ? open.z * seen.z / sum.z : open.z));
-    }
-    vec3 tt, bb;
-    v3_frame(n, &tt, &bb);
-    vec3f open = f3_splat(0.0f);
-    sky_part share = sky_share(t->light_split, f->q.gather);
-    int taken = 0;
-    vec3f dir[SKY_PACKET], tr[SKY_PACKET];
-    for (int k = share.first; k < f->q.gather;) {
-        int rays = 0;
-        for (; k < f->q.gather && rays < SKY_PACKET; k++) {
-            if (!sky_takes(&share, k))
-                continue;
-            const vec3 *dk = &f->dirs[k];
-            vec3 d = v3_add(v3_add(v3_scale(tt, dk->x), v3_scale(bb, dk->y)), v3_scale(n, dk->z));
-            dir[rays++] = v3_to_f3(d);
-        }
-        sky_gather_rays(t, o, dir, rays, picks, picked, tr);
-        for (int i = 0; i < rays; i++)
-            open = f3_add(open, tr[i]);
-        taken += rays;
-    }
-    /* Each channel as sky x (pi x count / n): open holds whole counts
-     * unless a pane is in the way. */
-    return v3_add(portals, v3(rs->sky.x * (3.14159265358979 * open.x / taken),
-                              rs->sky.y * (3.14159265358979 * open.y / taken),
-                              rs->sky.z * (3.14159265358979 * open.z / taken)));
-}
 
 /* Mesh vertex nodes share a cut (node_groups.h) within GROUP_RADIUS x h
  * of their group's leader, normals within acos(GROUP_NORMAL) of its; a
@@ -317,25 +62,32 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
  * and groups within h/4 or h/2 taking their leader's value 1.425% and
  * 1.498% for about 1 s less. */
 #define GROUP_COPY_LEVEL 2
-/* The camera's samples gather their light on meshes (gather.c), so a
- * mesh's nodes are read only by the gathers' rays and as senders, which
- * average many of them: a receiver on a mesh opens a quarter of the
- * level's limit.  The engine room at depth 3, 512 x 512 (whole job, single
- * runs, before the gathers' per-pixel directions): x 5/4 (as without
- * gathers) about 37 s for 0.916% per pixel and 0.558% over 4 x 4 blocks,
- * x 1/2 20.3 s for 0.923% / 0.552%, x 1/4 15.7 s for 0.927% / 0.567%, x 1/8
- * 13.8 s for 1.093% / 0.786% (cuts at their limit leave the floor 0.35%
- * short).  Members of a group taking their leader's value from E_1 on as
- * well: 0.8 s less for 0.935% / 0.574%. */
-#define GATHERED_MESH_CUT_DIV 4
-/* For the same reason a mesh node's gather is kept at the error a cut of
- * that quarter limit allows: a cut's error goes about as one over the
- * square root of its clusters, so the level's eps times the square root
- * of the limit's divisor: twice it.  Whole jobs: the
- * engine room 256 x 256 A/B 0.967, 0.930% -> 0.928% per pixel; Wuson
- * alone A/B 0.875, 0.273% -> 0.279%; house_day at quality 0 (single runs)
- * Phase One 11.75 -> 11.45 s, 2.200% both. */
-#define GATHERED_MESH_EPS_MUL sqrt((double)GATHERED_MESH_CUT_DIV)
+/* ZONE_MESH_NODE_DIV (zone.h): the camera's samples gather their light on
+ * meshes (gather.c), so a mesh's nodes are read only by the gathers' rays
+ * and as senders, which average many of them.
+ *
+ * Its cut opens a quarter of the level's limit.  The engine room at depth
+ * 3, 512 x 512 (whole job, single runs, before the gathers' per-pixel
+ * directions): x 5/4 (as without gathers) about 37 s for 0.916% per pixel
+ * and 0.558% over 4 x 4 blocks, x 1/2 20.3 s for 0.923% / 0.552%, x 1/4
+ * 15.7 s for 0.927% / 0.567%, x 1/8 13.8 s for 1.093% / 0.786% (cuts at
+ * their limit leave the floor 0.35% short).  Members of a group taking
+ * their leader's value from E_1 on as well: 0.8 s less for 0.935% /
+ * 0.574%.
+ *
+ * MESH_NODE_DIRECTIONS: its sky and its gather take a quarter of the
+ * directions (the gather at least 64: bounce_gather_count), each node's
+ * set turned about its normal (or, of an environment map's, one of 16
+ * shifted sets) by a key of its own, so that neighbouring nodes err apart
+ * and the reads' averages take their errors out.  Whole jobs against every
+ * direction at every node: Wuson alone A/B 0.664, 0.279% -> 0.273% per
+ * pixel; the engine room at 256 x 256 A/B 0.806, 0.931% -> 0.932%;
+ * house_day and house_inside at the default quality 0.71 and 0.70 (single
+ * runs), 1.848% -> 1.850% and 16.0% -> 15.4%.  One quarter set at every
+ * node instead: Wuson 0.2733% (0.2728% set apart), the engine room 0.9331%
+ * (0.9323%), house_inside at quality 0 23.46% (23.33%); the nodes
+ * themselves are tested in tests/test_sky_gather.c. */
+#define GATHERED_MESH_EPS_MUL sqrt((double)ZONE_MESH_NODE_DIV)
 
 /* Where a triangle node's light is computed: moved this share of the way
  * toward its triangle's centroid.  A node on a triangle's edge or corner
@@ -385,6 +137,11 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
     int prim = sn->prim_of[k];
     vec3 e;
     *gathered = 0;
+    int on_mesh = prim >= r->rs.part_count;
+    /* A mesh node's sky and gather take a quarter of the directions, set
+     * apart from its neighbours' (MESH_NODE_DIRECTIONS). */
+    if (on_mesh)
+        t.node_draw = zone_node_draw_key(k, level);
     if (level == 0) {
         e = zone_lights_at(&t, prim, x, n);
         if (f->sky)
@@ -398,13 +155,15 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
     transfer_ctx tk = *tc;
     tk.eps = tc->eps * sqrt(sn->growth[k]);
     bounce_limit lim = {.eps = tk.eps, .lower = light_below(f, level, k), .floor = tc->floor};
-    int on_mesh = prim >= r->rs.part_count;
-    if (on_mesh)
+    int gather_dirs = f->q.gather;
+    if (on_mesh) {
         lim.eps *= GATHERED_MESH_EPS_MUL;
-    *gathered = bounce_gather(&t, f->bounce_dirs, f->q.gather, x, n, level, &lim, &e);
+        gather_dirs = bounce_gather_count(gather_dirs, ZONE_MESH_NODE_DIV);
+    }
+    *gathered = bounce_gather(&t, f->bounce_dirs, gather_dirs, x, n, level, &lim, &e);
     if (!*gathered) {
         if (on_mesh)
-            tk.max_cut = tc->max_cut / GATHERED_MESH_CUT_DIV;
+            tk.max_cut = tc->max_cut / ZONE_MESH_NODE_DIV;
         transfer_stats ts = {0};
         e = from ? transfer_irradiance_near(&tk, x, n, from, tk.max_cut / GROUP_MORE, &ts)
                  : transfer_irradiance(&tk, x, n, prim, &ts, rec);

@@ -13,6 +13,15 @@
 /* The fewest directions whose spread says whether the rest are worth
  * casting. */
 #define FIRST_MIN 16
+
+int bounce_gather_count(int n_dirs, int div)
+{
+    /* Fewer than four times FIRST_MIN would leave no first quarter to
+     * test, and a few directions' spread says little: with 16, a sunlit
+     * patch that none of them meets looks like no light at all. */
+    int least = n_dirs < 4 * FIRST_MIN ? n_dirs : 4 * FIRST_MIN;
+    return n_dirs / div > least ? n_dirs / div : least;
+}
 /* Directions traced together. */
 #define BATCH 64
 
@@ -63,6 +72,9 @@ int bounce_gather(zone_trace *t, const vec3 *dirs, int n_dirs, vec3 x, vec3 n, i
 {
     vec3 tt, bb;
     v3_frame(n, &tt, &bb);
+    /* A mesh node's set, turned apart from its neighbours' (zone.h). */
+    if (t->node_draw)
+        v3_turn_frame(&tt, &bb, zone_node_turn(t->node_draw));
     vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
     vec3 sum = v3(0, 0, 0);
     double s1 = 0, s2 = 0;

@@ -20,6 +20,12 @@
  * have cast a stratified set. */
 vec3 *bounce_directions(int n);
 
+/* How many of n_dirs a node takes that is held to a div-th of the
+ * directions (a mesh's node: ZONE_MESH_NODE_DIV): n_dirs / div, but no
+ * fewer than a gather needs for its first quarter's test (64), nor more
+ * than n_dirs. */
+int bounce_gather_count(int n_dirs, int div);
+
 typedef struct bounce_limit {
     double eps;     /* the error allowed, as a share of ... */
     double lower;   /* ... the node's light of the levels below (luminance) */
