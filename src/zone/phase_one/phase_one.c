@@ -155,12 +155,12 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
     transfer_ctx tk = *tc;
     tk.eps = tc->eps * sqrt(sn->growth[k]);
     bounce_limit lim = {.eps = tk.eps, .lower = light_below(f, level, k), .floor = tc->floor};
-    int gather_dirs = f->q.gather;
+    int least = f->q.gather;
     if (on_mesh) {
         lim.eps *= GATHERED_MESH_EPS_MUL;
-        gather_dirs = bounce_gather_count(gather_dirs, ZONE_MESH_NODE_DIV);
+        least = bounce_gather_count(least, ZONE_MESH_NODE_DIV);
     }
-    *gathered = bounce_gather(&t, f->bounce_dirs, gather_dirs, x, n, level, &lim, &e);
+    *gathered = bounce_gather(&t, f->bounce_dirs, least, f->q.gather, x, n, level, &lim, &e);
     if (!*gathered) {
         if (on_mesh)
             tk.max_cut = tc->max_cut / ZONE_MESH_NODE_DIV;

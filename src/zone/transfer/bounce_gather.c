@@ -67,8 +67,22 @@ static int good_enough(double s1, double s2, int count, int n_dirs, const bounce
     return err <= lim->eps * fmax(lim->lower + PI * mean, lim->floor);
 }
 
-int bounce_gather(zone_trace *t, const vec3 *dirs, int n_dirs, vec3 x, vec3 n, int level,
-                  const bounce_limit *lim, vec3 *e)
+/* The count a gather that has cast k directions goes on to: the
+ * smallest of least, 4 least, ... n_dirs above k at which its error
+ * would be within the limit; 0 when none would (the cut's node). */
+static int next_count(double s1, double s2, int k, int least, int n_dirs,
+                      const bounce_limit *lim)
+{
+    for (int c = least;; c = c * 4 < n_dirs ? c * 4 : n_dirs) {
+        if (c > k && good_enough(s1, s2, k, c, lim))
+            return c;
+        if (c >= n_dirs)
+            return 0;
+    }
+}
+
+int bounce_gather(zone_trace *t, const vec3 *dirs, int least, int n_dirs, vec3 x, vec3 n,
+                  int level, const bounce_limit *lim, vec3 *e)
 {
     vec3 tt, bb;
     v3_frame(n, &tt, &bb);
@@ -78,37 +92,39 @@ int bounce_gather(zone_trace *t, const vec3 *dirs, int n_dirs, vec3 x, vec3 n, i
     vec3f o = ray_offset(v3_to_f3(x), v3_to_f3(n));
     vec3 sum = v3(0, 0, 0);
     double s1 = 0, s2 = 0;
-    int first = n_dirs / 4 >= FIRST_MIN ? n_dirs / 4 : n_dirs;
+    int target = least / 4 >= FIRST_MIN ? least / 4 : least;
     /* The rays go to the scene a batch at a time (packets from one
      * point), their hits then read one by one. */
     vec3f dir[BATCH];
     hit hits[BATCH];
-    int batch_start = 0, batch_end = 0;
-    for (int k = 0; k < n_dirs; k++) {
-        if (k == first && !good_enough(s1, s2, k, n_dirs, lim))
-            return 0;
-        if (k == batch_end) {
-            int end = k < first ? first : n_dirs;
-            batch_start = k;
-            batch_end = end - k < BATCH ? end : k + BATCH;
-            for (int j = k; j < batch_end; j++) {
+    int k = 0;
+    for (;;) {
+        while (k < target) {
+            int end = target - k < BATCH ? target : k + BATCH;
+            for (int j = k; j < end; j++) {
                 vec3 d = v3_add(v3_add(v3_scale(tt, dirs[j].x), v3_scale(bb, dirs[j].y)),
                                 v3_scale(n, dirs[j].z));
                 dir[j - k] = v3_to_f3(v3_normalize(d));
             }
-            accel_intersect_n(&t->r->rs, o, dir, batch_end - k, hits);
-            t->rays += (uint64_t)(batch_end - k);
+            accel_intersect_n(&t->r->rs, o, dir, end - k, hits);
+            t->rays += (uint64_t)(end - k);
+            for (int j = k; j < end; j++) {
+                t->first_hit = &hits[j - k];
+                vec3 l = zone_radiance(t, o, dir[j - k], level, level,
+                                       ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0);
+                double y = lum(l);
+                s1 += y;
+                s2 += y * y;
+                sum = v3_add(sum, l);
+            }
+            k = end;
         }
-        t->first_hit = &hits[k - batch_start];
-        vec3 l = zone_radiance(t, o, dir[k - batch_start], level, level,
-                               ZR_NO_GLINT | ZR_NO_CAUSTIC, NULL, 0);
-        double y = lum(l);
-        s1 += y;
-        s2 += y * y;
-        sum = v3_add(sum, l);
+        if (k >= least && good_enough(s1, s2, k, k, lim))
+            break;
+        target = next_count(s1, s2, k, least, n_dirs, lim);
+        if (!target)
+            return 0;
     }
-    if (!good_enough(s1, s2, n_dirs, n_dirs, lim))
-        return 0;
-    *e = v3_scale(sum, PI / n_dirs);
+    *e = v3_scale(sum, PI / k);
     return 1;
 }

@@ -20,8 +20,8 @@
  * have cast a stratified set. */
 vec3 *bounce_directions(int n);
 
-/* How many of n_dirs a node takes that is held to a div-th of the
- * directions (a mesh's node: ZONE_MESH_NODE_DIV): n_dirs / div, but no
+/* The fewest of n_dirs that a node held to a div-th of the directions (a
+ * mesh's node: ZONE_MESH_NODE_DIV) may stop at: n_dirs / div, but no
  * fewer than a gather needs for its first quarter's test (64), nor more
  * than n_dirs. */
 int bounce_gather_count(int n_dirs, int div);
@@ -35,13 +35,16 @@ typedef struct bounce_limit {
 /* The irradiance of level `level` at x (unit normal n) by gathering over
  * dirs[0..n_dirs): each direction reads the radiance of level `level`
  * along its ray (diffuse maps, specular chains; not glints or caustics,
- * which are taken apart).  A quarter of the directions first: when the
- * estimated error of the whole gather (pi times the samples' standard
- * deviation over sqrt(n_dirs)) already exceeds eps x max(lower + the
- * estimate, floor), it stops there and returns 0 (the cut is for this
- * node); else the rest, the same test with all of them, and 1 with the
- * irradiance in *e. */
-int bounce_gather(zone_trace *t, const vec3 *dirs, int n_dirs, vec3 x, vec3 n, int level,
-                  const bounce_limit *lim, vec3 *e);
+ * which are taken apart).  A quarter of `least` first; then, at each
+ * count cast, the gather stops when it has cast at least `least` and its
+ * estimated error (pi times the samples' standard deviation over the
+ * square root of the count) is within eps x max(lower + the estimate,
+ * floor); else it goes on to the smallest of least, 4 least, ... n_dirs
+ * at which the error it projects would be, and returns 0 when none would
+ * (the cut is for this node).  1 with the irradiance in *e.  A node that
+ * takes every direction has least = n_dirs: a quarter, then all or the
+ * cut. */
+int bounce_gather(zone_trace *t, const vec3 *dirs, int least, int n_dirs, vec3 x, vec3 n,
+                  int level, const bounce_limit *lim, vec3 *e);
 
 #endif
