@@ -27,6 +27,7 @@
 #include "zone/light/direct.h"
 #include "zone/light/lambert.h"
 #include "zone/light/occluders.h"
+#include "zone/light/sky_gather.h"
 #include "zone/zone.h"
 #include "zonetrace/render.h"
 #include "zonetrace/scene.h"

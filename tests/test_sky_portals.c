@@ -26,6 +26,7 @@
 #include "render/prim.h"
 #include "render/render_internal.h"
 #include "util/vec3_convert.h"
+#include "zone/light/sky_gather.h"
 #include "zone/light/sky_portals.h"
 #include "zone/zone.h"
 #include "zonetrace/render.h"

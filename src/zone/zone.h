@@ -130,9 +130,10 @@ static inline double zone_node_turn(uint32_t key)
 {
     return (key & 0xffffff) * (2 * 3.14159265358979323846 / 16777216.0);
 }
+_Static_assert(ZONE_NODE_SKY_SETS == 16, "zone_node_set takes the key's top 4 bits");
 static inline int zone_node_set(uint32_t key)
 {
-    return (int)(key >> 28) & (ZONE_NODE_SKY_SETS - 1);
+    return (int)(key >> 28);
 }
 
 /* Directions drawn from an environment map, each with its radiance /
@@ -357,9 +358,6 @@ static inline vec3f zone_background(const rscene *rs, vec3f d)
     return rs->distant.any ? f3_add(rs->sky, distant_radiance(&rs->distant, d)) : rs->sky;
 }
 
-/* The sky's direct irradiance at x (normal n), gathered over the forest's
- * directions. */
-vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n);
 /* The direct irradiance of every light (exact, direct.c; a light cut when
  * there are many) at x (normal n) on primitive `receiver`, without the
  * sky's. */

@@ -11,7 +11,10 @@
  * and level, and the irradiance of every node. */
 /* 14: the same fields; level 0 under a sky takes window panes as portals
  * (light/sky_portals.h), so levels made before differ. */
-#define FOREST_FILE_VERSION 15 /* 15: the caustic photons */
+/* 15: the caustic photons.  16: the same fields; a mesh node takes a
+ * quarter of the sky's and the gather's directions (light/sky_gather.h),
+ * so levels made before differ. */
+#define FOREST_FILE_VERSION 16
 
 /* Writes f (the forest of renderer r) to path, through a temporary file
  * renamed into place. */

@@ -322,6 +322,38 @@ static void sky_cosines(const zone_sky_set *set, vec3f n, int k0, float *c, f4 a
     }
 }
 
+/* What the map's directions of `set` above the horizon of n (the split
+ * point's share of them) find arriving from o: the sum of weight x cosine
+ * x transmittance, standing for all of them; their whole weight x cosine
+ * into *sum (which costs no ray). */
+static vec3f map_seen(zone_trace *t, const zone_sky_set *set, vec3f n, vec3f o,
+                      const sky_portal_pick *picks, int picked, vec3f *sum)
+{
+    vec3f seen = f3_splat(0.0f);
+    sky_part share = sky_share(t->light_split, set->count);
+    f4 all[3] = {f4_splat(0.0f), f4_splat(0.0f), f4_splat(0.0f)};
+    vec3f dir[ZONE_SKY_RUN], tr[ZONE_SKY_RUN];
+    float cosine[ZONE_SKY_RUN];
+    int kept[ZONE_SKY_RUN];
+    for (int k0 = 0; k0 < set->count; k0 += ZONE_SKY_RUN) {
+        sky_cosines(set, n, k0, cosine, all);
+        int rays = 0, end = set->count - k0 < ZONE_SKY_RUN ? set->count - k0 : ZONE_SKY_RUN;
+        for (int j = 0; j < end; j++)
+            if (cosine[j] > 0.0f && sky_takes(&share, k0 + j)) {
+                dir[rays] = set->dirs[k0 + j];
+                kept[rays++] = j;
+            }
+        sky_gather_rays(t, o, dir, rays, picks, picked, tr);
+        for (int i = 0; i < rays; i++)
+            if (!f3_is_black(tr[i]))
+                seen = f3_madd(seen, f3_mul(set->weight[k0 + kept[i]], tr[i]), cosine[kept[i]]);
+    }
+    *sum = f3(f4_hsum(all[0]), f4_hsum(all[1]), f4_hsum(all[2]));
+    /* A split point's share of the directions stands for all of them: the
+     * block's points together see what one point's would. */
+    return f3_scale(seen, (float)share.stride / (float)share.width);
+}
+
 vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
 {
     const zone_forest *f = t->f;
@@ -339,32 +371,14 @@ vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n)
          * the share's whole is taken over every direction, which costs no
          * ray).  A mesh node takes the shifted set its key names. */
         const zone_sky_set *set =
-            t->node_draw ? &f->node_sky[zone_node_set(t->node_draw)]
-                         : &f->sky_set;
-        vec3f seen = f3_splat(0.0f);
-        sky_part share = sky_share(t->light_split, set->count);
-        f4 all[3] = {f4_splat(0.0f), f4_splat(0.0f), f4_splat(0.0f)};
-        vec3f dir[ZONE_SKY_RUN], tr[ZONE_SKY_RUN];
-        float cosine[ZONE_SKY_RUN];
-        int kept[ZONE_SKY_RUN];
-        for (int k0 = 0; k0 < set->count; k0 += ZONE_SKY_RUN) {
-            sky_cosines(set, nf, k0, cosine, all);
-            int rays = 0, end = set->count - k0 < ZONE_SKY_RUN ? set->count - k0 : ZONE_SKY_RUN;
-            for (int j = 0; j < end; j++)
-                if (cosine[j] > 0.0f && sky_takes(&share, k0 + j)) {
-                    dir[rays] = set->dirs[k0 + j];
-                    kept[rays++] = j;
-                }
-            sky_gather_rays(t, o, dir, rays, picks, picked, tr);
-            for (int i = 0; i < rays; i++)
-                if (!f3_is_black(tr[i]))
-                    seen = f3_madd(seen, f3_mul(set->weight[k0 + kept[i]], tr[i]),
-                                   cosine[kept[i]]);
-        }
-        vec3f sum = f3(f4_hsum(all[0]), f4_hsum(all[1]), f4_hsum(all[2]));
-        /* A split point's share of the directions stands for all of them:
-         * the block's points together see what one point's would. */
-        seen = f3_scale(seen, (float)share.stride / (float)share.width);
+            t->node_draw ? &f->node_sky[zone_node_set(t->node_draw)] : &f->sky_set;
+        vec3f sum, seen = map_seen(t, set, nf, o, picks, picked, &sum);
+        /* A quarter set may hold no direction above the node's horizon
+         * (a normal turned from where the map's light is): the whole set
+         * then measures, or the node would take the open surface's light
+         * unshadowed. */
+        if (set != &f->sky_set && sum.x <= 0.0f && sum.y <= 0.0f && sum.z <= 0.0f)
+            seen = map_seen(t, &f->sky_set, nf, o, picks, picked, &sum);
         vec3 open = sky_open_irradiance(f, nf);
         return v3_add(portals, v3(sum.x > 0.0f ? open.x * seen.x / sum.x : open.x,
                                   sum.y > 0.0f ? open.y * seen.y / sum.y : open.y,

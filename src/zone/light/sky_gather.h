@@ -21,6 +21,10 @@
 
 #include "zone/zone.h"
 
+/* The sky's direct irradiance at x (unit normal n): a camera sample's or
+ * a node's (t->node_draw: a mesh node's quarter set). */
+vec3 zone_sky_irradiance(zone_trace *t, vec3 x, vec3 n);
+
 /* The forest's sky directions and the map's open-surface table (none
  * without a sky); 0 when out of memory. */
 int zone_sky_build(zone_forest *f, const rscene *rs);

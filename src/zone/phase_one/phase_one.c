@@ -16,11 +16,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "geom/accel.h"
 #include "render/prim.h"
 #include "render/share.h"
 #include "util/error.h"
 #include "util/vec3_convert.h"
+#include "zone/light/sky_gather.h"
 #include "zone/maps/mesh_rounds.h"
 #include "zone/maps/node_groups.h"
 #include "zone/maps/node_twins.h"
@@ -75,7 +75,7 @@
  * their leader's value from E_1 on as well: 0.8 s less for 0.935% /
  * 0.574%.
  *
- * MESH_NODE_DIRECTIONS: its sky and its gather take a quarter of the
+ * Its sky and its gather take a quarter of the
  * directions (the gather at least 64: bounce_gather_count), each node's
  * set turned about its normal (or, of an environment map's, one of 16
  * shifted sets) by a key of its own, so that neighbouring nodes err apart
@@ -137,9 +137,9 @@ static vec3 node_value(zone_forest *f, const zt_renderer *r, int level, const tr
     int prim = sn->prim_of[k];
     vec3 e;
     *gathered = 0;
-    int on_mesh = prim >= r->rs.part_count;
     /* A mesh node's sky and gather take a quarter of the directions, set
-     * apart from its neighbours' (MESH_NODE_DIRECTIONS). */
+     * apart from its neighbours' (ZONE_MESH_NODE_DIV above). */
+    int on_mesh = zone_gathers(&r->rs, prim);
     if (on_mesh)
         t.node_draw = zone_node_draw_key(k, level);
     if (level == 0) {

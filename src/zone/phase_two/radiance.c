@@ -25,6 +25,7 @@
 #include "zone/phase_two/media.h"
 #include "zone/phase_one/specular_targets.h"
 #include "zone/phase_one/glint.h"
+#include "zone/light/sky_gather.h"
 
 
 

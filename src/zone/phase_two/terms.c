@@ -19,6 +19,7 @@
 #include "render/prim.h"
 #include "util/error.h"
 #include "util/vec3_convert.h"
+#include "zone/light/sky_gather.h"
 #include "zone/phase_two/phase_two.h"
 
 #define SHADE_FLAGS (ZR_EXACT_DIRECT | ZR_NO_EMISSION)

@@ -14,6 +14,9 @@
  * casting. */
 #define FIRST_MIN 16
 
+/* Directions traced together. */
+#define BATCH 64
+
 int bounce_gather_count(int n_dirs, int div)
 {
     /* Fewer than four times FIRST_MIN would leave no first quarter to
@@ -22,8 +25,6 @@ int bounce_gather_count(int n_dirs, int div)
     int least = n_dirs < 4 * FIRST_MIN ? n_dirs : 4 * FIRST_MIN;
     return n_dirs / div > least ? n_dirs / div : least;
 }
-/* Directions traced together. */
-#define BATCH 64
 
 /* Sobol's second dimension: the direction numbers of x + 1, each the one
  * before xor itself shifted by one. */
@@ -73,6 +74,8 @@ static int good_enough(double s1, double s2, int count, int n_dirs, const bounce
 static int next_count(double s1, double s2, int k, int least, int n_dirs,
                       const bounce_limit *lim)
 {
+    if (least < 1)
+        least = 1;
     for (int c = least;; c = c * 4 < n_dirs ? c * 4 : n_dirs) {
         if (c > k && good_enough(s1, s2, k, c, lim))
             return c;
