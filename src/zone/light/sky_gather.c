@@ -118,6 +118,8 @@ int zone_sky_build(zone_forest *f, const rscene *rs)
     int n = f->q.gather, quarter = n / ZONE_MESH_NODE_DIV > 0 ? n / ZONE_MESH_NODE_DIV : 1;
     if (!f->sky)
         return 1;
+    /* (Under a map too: a map whose every direction is dark leaves its
+     * sets empty, and zone_sky_irradiance then takes the colour's way.) */
     f->node_dirs = zone_gather_directions(quarter);
     f->node_dir_count = quarter;
     if (!f->node_dirs)

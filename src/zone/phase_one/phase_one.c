@@ -75,18 +75,24 @@
  * their leader's value from E_1 on as well: 0.8 s less for 0.935% /
  * 0.574%.
  *
- * Its sky and its gather take a quarter of the
- * directions (the gather at least 64: bounce_gather_count), each node's
- * set turned about its normal (or, of an environment map's, one of 16
- * shifted sets) by a key of its own, so that neighbouring nodes err apart
- * and the reads' averages take their errors out.  Whole jobs against every
+ * Its sky and its gather take a quarter of the directions (the gather
+ * at least 64: bounce_gather_count), each node's set turned about its
+ * normal (or, of an environment map's, one of 16 shifted sets) by a key of
+ * its own, so that neighbouring nodes err apart and the reads' averages
+ * take their errors out.  Whole jobs against every
  * direction at every node: Wuson alone A/B 0.664, 0.279% -> 0.273% per
  * pixel; the engine room at 256 x 256 A/B 0.806, 0.931% -> 0.932%;
  * house_day and house_inside at the default quality 0.71 and 0.70 (single
  * runs), 1.848% -> 1.850% and 16.0% -> 15.4%.  One quarter set at every
  * node instead: Wuson 0.2733% (0.2728% set apart), the engine room 0.9331%
  * (0.9323%), house_inside at quality 0 23.46% (23.33%); the nodes
- * themselves are tested in tests/test_sky_gather.c. */
+ * themselves are tested in tests/test_sky_gather.c.
+ *
+ * Its gather is kept at the error a cut of that quarter limit allows: a
+ * cut's error goes about as one over the square root of its clusters, so
+ * the level's eps times the square root of the divisor, twice it (measured
+ * with every direction: the engine room 256 x 256 A/B 0.967, 0.930% ->
+ * 0.928% per pixel; Wuson alone A/B 0.875, 0.273% -> 0.279%). */
 #define GATHERED_MESH_EPS_MUL sqrt((double)ZONE_MESH_NODE_DIV)
 
 /* Where a triangle node's light is computed: moved this share of the way
